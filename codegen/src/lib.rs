@@ -1,0 +1,108 @@
+//! dalembert's generator: a model file to specialised, allocation-free Rust.
+//!
+//! The pipeline has visible stages:
+//!
+//! 1. [`ir`]: the model file (TOML) to a validated [`ir::Model`], every error
+//!    collected with file:line:col;
+//! 2. [`symbolic`]: G, A, each wall's B, P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B and the
+//!    collision map (I − 2P)v, derived exactly, the paper's hypotheses checked,
+//!    and each emitted function optimised into straight-line instructions
+//!    ([`program::Program`]);
+//! 3. [`emit`]: Rust tokens for the model, formatted with prettyplease.
+//!
+//! Front ends: [`compile_dir`] for build scripts (see the workspace's
+//! `build.rs`), [`generate`] and [`derive`] for the CLI and for tests.
+//!
+//! The symbolic engine (symbolica) is used only inside [`symbolic`], only at
+//! build time, and only by one thread of one process at a time ([`lock`]).
+
+pub mod diag;
+pub mod emit;
+pub mod ir;
+pub mod lock;
+pub mod program;
+pub mod reference;
+pub mod symbolic;
+
+use std::path::{Path, PathBuf};
+
+pub use diag::{Diagnostic, ErrorKind, ModelErrors};
+pub use symbolic::Derivation;
+
+/// Validates and derives the model in `path`.
+pub fn derive(path: &Path) -> Result<Derivation, ModelErrors> {
+    let model = ir::load(path)?;
+    symbolic::derive(&model)
+}
+
+/// The formatted Rust source for the model in `path`.
+pub fn generate(path: &Path) -> Result<String, ModelErrors> {
+    let d = derive(path)?;
+    Ok(emit::file(&d))
+}
+
+/// One model's generated file and what it took to make it.
+#[derive(Debug, Clone)]
+pub struct Generated {
+    /// The model file.
+    pub model_file: PathBuf,
+    /// The written Rust file.
+    pub rust_file: PathBuf,
+    /// The model's type name.
+    pub type_name: String,
+    /// Number of coordinates.
+    pub q: usize,
+    /// Number of velocity components.
+    pub n: usize,
+}
+
+/// Generates every `*.toml` model in `models_dir` into `out_dir` (one file per
+/// model plus `models.rs`, which includes them all). Errors of every model are
+/// collected before returning.
+pub fn compile_dir(models_dir: &Path, out_dir: &Path) -> Result<Vec<Generated>, Vec<ModelErrors>> {
+    let mut files: Vec<PathBuf> = match std::fs::read_dir(models_dir) {
+        Ok(rd) => rd
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+            .collect(),
+        Err(e) => {
+            let mut cx = diag::Collector::new(models_dir, "");
+            cx.error(ErrorKind::Io(e.to_string()), None);
+            return Err(vec![cx.into_errors()]);
+        }
+    };
+    files.sort();
+    let mut done = Vec::new();
+    let mut errors = Vec::new();
+    for file in files {
+        match derive(&file) {
+            Ok(d) => {
+                let rust_file = out_dir.join(format!("{}.rs", d.model.name));
+                if let Err(e) = std::fs::write(&rust_file, emit::file(&d)) {
+                    let mut cx = diag::Collector::new(&file, "");
+                    cx.error(ErrorKind::Io(format!("{}: {e}", rust_file.display())), None);
+                    errors.push(cx.into_errors());
+                    continue;
+                }
+                done.push(Generated {
+                    model_file: file,
+                    rust_file,
+                    type_name: d.model.type_name(),
+                    q: d.model.coordinates.len(),
+                    n: d.model.velocities.len(),
+                });
+            }
+            Err(e) => errors.push(e),
+        }
+    }
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+    let index = emit::index(&done);
+    if let Err(e) = std::fs::write(out_dir.join("models.rs"), index) {
+        let mut cx = diag::Collector::new(models_dir, "");
+        cx.error(ErrorKind::Io(e.to_string()), None);
+        return Err(vec![cx.into_errors()]);
+    }
+    Ok(done)
+}

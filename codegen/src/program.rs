@@ -1,0 +1,204 @@
+//! Straight-line numeric programs: what the symbolic stage hands the emitter.
+//!
+//! A [`Program`] evaluates several outputs from a list of inputs in a fixed
+//! sequence of instructions, with common subexpressions already shared (the
+//! symbolic engine's evaluator optimisation produces it). It does not depend
+//! on the symbolic engine, so the emitter and tests can use it freely.
+
+/// Where a value lives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Slot {
+    /// The i-th input.
+    Input(usize),
+    /// The i-th constant.
+    Const(usize),
+    /// A temporary.
+    Temp(usize),
+    /// The i-th output.
+    Out(usize),
+}
+
+/// A function a program may call.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Func {
+    /// sin
+    Sin,
+    /// cos
+    Cos,
+    /// tan
+    Tan,
+    /// exp
+    Exp,
+    /// natural log
+    Log,
+    /// square root
+    Sqrt,
+}
+
+impl Func {
+    /// By name.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Some(match name {
+            "sin" => Self::Sin,
+            "cos" => Self::Cos,
+            "tan" => Self::Tan,
+            "exp" => Self::Exp,
+            "log" => Self::Log,
+            "sqrt" => Self::Sqrt,
+            _ => return None,
+        })
+    }
+
+    /// Its name (also the libm function's).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Sin => "sin",
+            Self::Cos => "cos",
+            Self::Tan => "tan",
+            Self::Exp => "exp",
+            Self::Log => "log",
+            Self::Sqrt => "sqrt",
+        }
+    }
+
+    /// Its value at x.
+    pub fn apply(self, x: f64) -> f64 {
+        match self {
+            Self::Sin => x.sin(),
+            Self::Cos => x.cos(),
+            Self::Tan => x.tan(),
+            Self::Exp => x.exp(),
+            Self::Log => x.ln(),
+            Self::Sqrt => x.sqrt(),
+        }
+    }
+}
+
+/// One instruction.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Instr {
+    /// dst = Σ srcs
+    Add(Slot, Vec<Slot>),
+    /// dst = Π srcs
+    Mul(Slot, Vec<Slot>),
+    /// dst = src^n
+    Pow(Slot, Slot, i64),
+    /// dst = f(src)
+    Fun(Slot, Func, Slot),
+    /// dst = src
+    Assign(Slot, Slot),
+}
+
+/// A straight-line program.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Program {
+    /// Number of inputs.
+    pub inputs: usize,
+    /// Constant values.
+    pub consts: Vec<f64>,
+    /// Instructions in order.
+    pub instrs: Vec<Instr>,
+    /// Number of outputs.
+    pub outputs: usize,
+}
+
+/// Arithmetic operations a program performs.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct OpCount {
+    /// Additions and subtractions.
+    pub add: usize,
+    /// Multiplications.
+    pub mul: usize,
+    /// Divisions (negative powers).
+    pub div: usize,
+    /// Function calls (sin, cos, ...).
+    pub fun: usize,
+}
+
+impl OpCount {
+    /// All operations.
+    pub fn total(&self) -> usize {
+        self.add + self.mul + self.div + self.fun
+    }
+}
+
+impl std::ops::Add for OpCount {
+    type Output = Self;
+    fn add(self, o: Self) -> Self {
+        Self {
+            add: self.add + o.add,
+            mul: self.mul + o.mul,
+            div: self.div + o.div,
+            fun: self.fun + o.fun,
+        }
+    }
+}
+
+impl std::fmt::Display for OpCount {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} add, {} mul, {} div, {} fn ({} in all)",
+            self.add,
+            self.mul,
+            self.div,
+            self.fun,
+            self.total()
+        )
+    }
+}
+
+impl Program {
+    /// Runs the program on `inputs`.
+    pub fn eval(&self, inputs: &[f64]) -> Vec<f64> {
+        let mut temps: Vec<f64> = Vec::new();
+        let mut outs = vec![0.0; self.outputs];
+        let get = |s: Slot, temps: &Vec<f64>, outs: &Vec<f64>| match s {
+            Slot::Input(i) => inputs[i],
+            Slot::Const(i) => self.consts[i],
+            Slot::Temp(i) => temps[i],
+            Slot::Out(i) => outs[i],
+        };
+        for ins in &self.instrs {
+            let (dst, value) = match ins {
+                Instr::Add(d, s) => (*d, s.iter().map(|&x| get(x, &temps, &outs)).sum()),
+                Instr::Mul(d, s) => (*d, s.iter().map(|&x| get(x, &temps, &outs)).product()),
+                Instr::Pow(d, s, n) => (*d, get(*s, &temps, &outs).powi(*n as i32)),
+                Instr::Fun(d, f, s) => (*d, f.apply(get(*s, &temps, &outs))),
+                Instr::Assign(d, s) => (*d, get(*s, &temps, &outs)),
+            };
+            match dst {
+                Slot::Temp(i) => {
+                    if temps.len() <= i {
+                        temps.resize(i + 1, 0.0);
+                    }
+                    temps[i] = value;
+                }
+                Slot::Out(i) => outs[i] = value,
+                _ => {}
+            }
+        }
+        outs
+    }
+
+    /// The operations it performs (a power xⁿ counts |n| − 1 multiplications,
+    /// and one division when n < 0).
+    pub fn op_count(&self) -> OpCount {
+        let mut c = OpCount::default();
+        for ins in &self.instrs {
+            match ins {
+                Instr::Add(_, s) => c.add += s.len().saturating_sub(1),
+                Instr::Mul(_, s) => c.mul += s.len().saturating_sub(1),
+                Instr::Pow(_, _, n) => {
+                    c.mul += (n.unsigned_abs() as usize).saturating_sub(1);
+                    if *n < 0 {
+                        c.div += 1;
+                    }
+                }
+                Instr::Fun(..) => c.fun += 1,
+                Instr::Assign(..) => {}
+            }
+        }
+        c
+    }
+}

@@ -1,0 +1,136 @@
+//! Comparing a derivation with a reference: a matrix P and a collision law
+//! written down by hand (for instance, as printed in a paper).
+//!
+//! A reference file names the model and wall, gives P as an optional common
+//! prefactor times a matrix, and optionally the collision law v⁺ component by
+//! component. A law stated only for admissible velocities (A v = 0) lists, in
+//! `[admissible]`, velocities to eliminate with the constraints; both sides
+//! are compared after that substitution. Entries are compared exactly, as
+//! rational functions.
+
+use std::path::Path;
+
+use indexmap::IndexMap;
+use serde::Deserialize;
+
+use crate::symbolic::{self, Derivation};
+
+/// A reference read from a file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Reference {
+    /// The model's name.
+    pub model: String,
+    /// The wall's name.
+    pub wall: String,
+    /// Where the reference comes from.
+    #[serde(default)]
+    pub source: String,
+    /// A factor multiplying every entry of `projector`.
+    pub prefactor: Option<String>,
+    /// P as written.
+    pub projector: Vec<Vec<String>>,
+    /// v⁺ as written, in terms of v⁻ (named as the model's velocities).
+    #[serde(default)]
+    pub collision: Vec<String>,
+    /// Velocities to eliminate before comparing collision laws.
+    #[serde(default)]
+    pub admissible: IndexMap<String, String>,
+}
+
+/// One entry where derivation and reference differ.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Difference {
+    /// Row (0-based).
+    pub row: usize,
+    /// Column (0-based; 0 for a collision-law component).
+    pub col: usize,
+    /// The reference's entry (prefactor applied).
+    pub reference: String,
+    /// The derived entry.
+    pub derived: String,
+}
+
+/// The outcome of a comparison.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Comparison {
+    /// Entries of P that differ.
+    pub projector: Vec<Difference>,
+    /// Components of the collision law that differ.
+    pub collision: Vec<Difference>,
+    /// Whether a collision law was compared.
+    pub has_collision: bool,
+}
+
+impl Reference {
+    /// Reads a reference file.
+    pub fn load(path: &Path) -> Result<Self, String> {
+        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))
+    }
+
+    /// The reference's entry (i, j) of P with the prefactor applied.
+    pub fn entry(&self, i: usize, j: usize) -> String {
+        match &self.prefactor {
+            Some(f) => format!("({f})*({})", self.projector[i][j]),
+            None => self.projector[i][j].clone(),
+        }
+    }
+
+    /// Compares with `d`.
+    pub fn compare(&self, d: &Derivation) -> Result<Comparison, String> {
+        let wall = d
+            .walls
+            .iter()
+            .find(|w| w.name == self.wall)
+            .ok_or_else(|| format!("model `{}` has no wall `{}`", d.model.name, self.wall))?;
+        let n = d.model.velocities.len();
+        if self.projector.len() != n || self.projector.iter().any(|r| r.len() != n) {
+            return Err(format!("the reference P must be {n}×{n}"));
+        }
+        let mut projector = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                let reference = self.entry(i, j);
+                if !symbolic::same(&reference, &wall.projector[i][j])? {
+                    projector.push(Difference {
+                        row: i,
+                        col: j,
+                        reference,
+                        derived: wall.projector[i][j].clone(),
+                    });
+                }
+            }
+        }
+        let mut collision = Vec::new();
+        if !self.collision.is_empty() {
+            if self.collision.len() != n {
+                return Err(format!(
+                    "the reference collision law must have {n} components"
+                ));
+            }
+            let subs: Vec<(&str, &str)> = self
+                .admissible
+                .iter()
+                .map(|(k, v)| (k.as_str(), v.as_str()))
+                .collect();
+            for (i, (r, c)) in self.collision.iter().zip(&wall.collision).enumerate() {
+                let r_sub = symbolic::substitute(r, &subs)?;
+                let c_sub = symbolic::substitute(c, &subs)?;
+                if !symbolic::same(&r_sub, &c_sub)? {
+                    collision.push(Difference {
+                        row: i,
+                        col: 0,
+                        reference: r.clone(),
+                        derived: c.clone(),
+                    });
+                }
+            }
+        }
+        Ok(Comparison {
+            projector,
+            collision,
+            has_collision: !self.collision.is_empty(),
+        })
+    }
+}

@@ -1,0 +1,111 @@
+//! Small fixed-size linear algebra, without heap allocation.
+//!
+//! [`projector`] computes P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B numerically from G and the rows
+//! of B. Generated models evaluate P from its symbolic form instead; this is
+//! the generic path (and an independent check of the generated one).
+
+use nalgebra::SMatrix;
+
+/// Euclidean dot product.
+pub fn dot<const N: usize>(a: &[f64; N], b: &[f64; N]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// Matrix–vector product M v.
+pub fn mat_vec<const N: usize>(m: &[[f64; N]; N], v: &[f64; N]) -> [f64; N] {
+    let mut out = [0.0; N];
+    for (o, row) in out.iter_mut().zip(m) {
+        *o = dot(row, v);
+    }
+    out
+}
+
+/// Matrix product A B.
+pub fn mat_mul<const N: usize>(a: &[[f64; N]; N], b: &[[f64; N]; N]) -> [[f64; N]; N] {
+    let mut out = [[0.0; N]; N];
+    for i in 0..N {
+        for j in 0..N {
+            out[i][j] = (0..N).map(|k| a[i][k] * b[k][j]).sum();
+        }
+    }
+    out
+}
+
+/// The quadratic form ½ vᵀ G v.
+pub fn kinetic_energy<const N: usize>(g: &[[f64; N]; N], v: &[f64; N]) -> f64 {
+    0.5 * dot(v, &mat_vec(g, v))
+}
+
+/// Why [`projector`] could not compute P.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ProjectorError {
+    /// G is not (numerically) symmetric positive definite.
+    MassMatrixNotPositiveDefinite,
+    /// An input entry is NaN or infinite.
+    NonFinite,
+}
+
+/// P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B from G and the rows of B, without allocation.
+///
+/// With G = L Lᵀ (Cholesky) and w = Lᵀ v the metric becomes Euclidean and
+/// the rows of B become those of C = B L⁻ᵀ; P is L⁻ᵀ (orthogonal projector
+/// onto the row space of C) Lᵀ. The row space is spanned by Gram–Schmidt,
+/// so rows of B that depend on earlier ones (relative size below `1e-12`)
+/// are ignored rather than making BG⁻¹Bᵀ singular.
+pub fn projector<const N: usize>(
+    g: &[[f64; N]; N],
+    b_rows: &[[f64; N]],
+) -> Result<[[f64; N]; N], ProjectorError> {
+    let finite = |r: &[f64; N]| r.iter().all(|x| x.is_finite());
+    if !g.iter().all(finite) || !b_rows.iter().all(finite) {
+        return Err(ProjectorError::NonFinite);
+    }
+    let gm = SMatrix::<f64, N, N>::from_fn(|i, j| g[i][j]);
+    let chol = gm
+        .cholesky()
+        .ok_or(ProjectorError::MassMatrixNotPositiveDefinite)?;
+    let l = chol.l();
+    // Orthonormal basis of the row space of C = B L⁻ᵀ, i.e. of the columns
+    // of L⁻¹ Bᵀ.
+    let mut basis = [[0.0; N]; N];
+    let mut rank = 0;
+    for row in b_rows {
+        let bt = nalgebra::SVector::<f64, N>::from_fn(|i, _| row[i]);
+        let Some(c) = l.solve_lower_triangular(&bt) else {
+            return Err(ProjectorError::MassMatrixNotPositiveDefinite);
+        };
+        let mut c: [f64; N] = core::array::from_fn(|i| c[i]);
+        let size = dot(&c, &c).sqrt();
+        for e in &basis[..rank] {
+            let k = dot(e, &c);
+            for (ci, ei) in c.iter_mut().zip(e) {
+                *ci -= k * ei;
+            }
+        }
+        let rest = dot(&c, &c).sqrt();
+        if size > 0.0 && rest > 1e-12 * size && rank < N {
+            basis[rank] = c.map(|x| x / rest);
+            rank += 1;
+        }
+    }
+    // P_w = Σ e eᵀ; P = L⁻ᵀ P_w Lᵀ.
+    let mut pw = SMatrix::<f64, N, N>::zeros();
+    for e in &basis[..rank] {
+        let ev = nalgebra::SVector::<f64, N>::from_fn(|i, _| e[i]);
+        pw += ev * ev.transpose();
+    }
+    let lt = l.transpose();
+    let p_lt = pw * lt;
+    let Some(p) = lt.solve_upper_triangular(&p_lt) else {
+        return Err(ProjectorError::MassMatrixNotPositiveDefinite);
+    };
+    Ok(core::array::from_fn(|i| {
+        core::array::from_fn(|j| p[(i, j)])
+    }))
+}
+
+/// The collision map v⁺ = (I − 2P) v.
+pub fn reflect<const N: usize>(p: &[[f64; N]; N], v: &[f64; N]) -> [f64; N] {
+    let pv = mat_vec(p, v);
+    core::array::from_fn(|i| v[i] - 2.0 * pv[i])
+}

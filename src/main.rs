@@ -1,0 +1,255 @@
+//! The `dalembert` command line.
+//!
+//! `paper` derives the paper's models and compares them with what the paper
+//! prints; `derive` shows what the generator derives for any model file;
+//! `generate` writes its Rust code (to vendor it without symbolica);
+//! `check` compares a derivation with a reference file.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use dalembert::models::BallFloor;
+use dalembert::runtime::Model;
+use dalembert_codegen::reference::{Comparison, Reference};
+use dalembert_codegen::{Derivation, ModelErrors};
+
+const MODELS_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/models");
+
+#[derive(Parser)]
+#[command(
+    name = "dalembert",
+    version,
+    about = "Collisions in nonholonomic systems: derive, generate and check collision maps"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Derive P and the collision law for the paper's models (§3.1, §3.2) and
+    /// compare them with what the paper prints.
+    Paper {
+        /// Directory with the model files and `reference/`.
+        #[arg(long, default_value = MODELS_DIR)]
+        models: PathBuf,
+    },
+    /// Print G, A, and for every wall B, P and the collision law.
+    Derive {
+        /// The model file.
+        file: PathBuf,
+    },
+    /// Write the generated Rust code for a model file.
+    Generate {
+        /// The model file.
+        file: PathBuf,
+        /// Where to write it (default: standard output).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+    /// Compare a model's derived P (and collision law) with a reference file.
+    Check {
+        /// The model file.
+        file: PathBuf,
+        /// The reference file.
+        reference: PathBuf,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Paper { models } => paper(&models),
+        Command::Derive { file } => derive(&file).map(|d| print_derivation(&d)),
+        Command::Generate { file, output } => generate(&file, output.as_deref()),
+        Command::Check { file, reference } => check(&file, &reference),
+    };
+    match result {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::from(1),
+        Err(message) => {
+            eprintln!("{message}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn derive(file: &Path) -> Result<Derivation, String> {
+    dalembert_codegen::derive(file).map_err(|e: ModelErrors| e.render())
+}
+
+fn generate(file: &Path, output: Option<&Path>) -> Result<bool, String> {
+    let code = dalembert_codegen::generate(file).map_err(|e| e.render())?;
+    match output {
+        Some(path) => std::fs::write(path, code).map_err(|e| format!("{}: {e}", path.display()))?,
+        None => print!("{code}"),
+    }
+    Ok(true)
+}
+
+fn check(file: &Path, reference: &Path) -> Result<bool, String> {
+    let d = derive(file)?;
+    let r = Reference::load(reference)?;
+    let c = r.compare(&d)?;
+    Ok(report(&d, &r, &c))
+}
+
+fn paper(models: &Path) -> Result<bool, String> {
+    let mut all_ok = true;
+    for (name, section) in [("ball_wall", "§3.1"), ("ball_floor", "§3.2")] {
+        let d = derive(&models.join(format!("{name}.toml")))?;
+        println!("==================== {section}: {name} ====================");
+        print_derivation(&d);
+        let r = Reference::load(&models.join("reference").join(format!("{name}.toml")))?;
+        let c = r.compare(&d)?;
+        all_ok &= report(&d, &r, &c);
+        println!();
+    }
+    pendulum_demo();
+    Ok(all_ok)
+}
+
+/// §3.2.1 with the generated code itself: the paper's initial data must
+/// come back reversed.
+fn pendulum_demo() {
+    let ball = BallFloor::default();
+    let p = ball.params;
+    let (v, u) = (1.5, 2.0);
+    let v_minus = [-v, 0.0, -u, 0.0, p.r * p.m * v / p.J, 0.0];
+    let v_plus = ball.collide(<BallFloor as Model<0, 6>>::WALLS[0], &[], &v_minus);
+    println!(
+        "==================== §3.2.1: nonholonomic pendulum (generated code) ===================="
+    );
+    println!("m = {}, r = {}, J = {}; v = {v}, u = {u}", p.m, p.r, p.J);
+    println!("v⁻ = {v_minus:?}");
+    println!("v⁺ = {v_plus:?}");
+    let reversed = v_plus
+        .iter()
+        .zip(&v_minus)
+        .all(|(a, b)| (a + b).abs() <= 1e-12 * (1.0 + b.abs()));
+    println!(
+        "v⁺ = −v⁻ (the ball returns along its parabola): {}",
+        if reversed { "yes" } else { "NO" }
+    );
+}
+
+fn print_matrix(title: &str, m: &[Vec<String>]) {
+    println!("{title}");
+    for row in m {
+        println!("  [ {} ]", row.join(", "));
+    }
+}
+
+fn print_derivation(d: &Derivation) -> bool {
+    let m = &d.model;
+    println!(
+        "model `{}` ({}): velocities ({})",
+        m.name,
+        m.file.display(),
+        m.velocities.join(", ")
+    );
+    if !m.coordinates.is_empty() {
+        println!("coordinates ({})", m.coordinates.join(", "));
+    }
+    print_matrix("G =", &d.mass_matrix);
+    if d.constraint_rows.is_empty() {
+        println!("A: no constraints");
+    } else {
+        print_matrix("A =", &d.constraint_rows);
+    }
+    for w in &d.walls {
+        println!("--- wall `{}` ---", w.name);
+        print_matrix(&format!("B = (rows: {})", w.b_origin.join("; ")), &w.b_rows);
+        if !w.dropped.is_empty() {
+            println!("  dependent rows removed: {}", w.dropped.join("; "));
+        }
+        print_matrix("P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B =", &w.projector);
+        println!("collision law v⁺ = (I − 2P)v⁻:");
+        for (name, c) in m.velocities.iter().zip(&w.collision) {
+            println!("  {name}⁺ = {c}");
+        }
+        println!(
+            "operation counts: projector {}; collision map {}",
+            w.programs.projector.op_count(),
+            w.programs.collide.op_count()
+        );
+    }
+    true
+}
+
+/// Prints the verdict; true when the derivation agrees with the reference
+/// except for entries printed as "1" inside a prefactor (a misprint of an
+/// entry that is exactly 1).
+fn report(d: &Derivation, r: &Reference, c: &Comparison) -> bool {
+    let n = d.model.velocities.len();
+    println!("--- compared with: {} ---", r.source);
+    let misprint = |i: usize, j: usize| {
+        r.prefactor.is_some()
+            && r.projector[i][j].trim() == "1"
+            && dalembert_codegen::symbolic::same(
+                &c.projector
+                    .iter()
+                    .find(|x| x.row == i && x.col == j)
+                    .map(|x| x.derived.clone())
+                    .unwrap_or_default(),
+                "1",
+            )
+            .unwrap_or(false)
+    };
+    let (known, other): (Vec<_>, Vec<_>) = c.projector.iter().partition(|x| misprint(x.row, x.col));
+    println!(
+        "P: {} of {} entries agree exactly",
+        n * n - c.projector.len(),
+        n * n
+    );
+    for x in &known {
+        println!(
+            "  entry ({},{}): the paper prints 1 inside the prefactor {}, i.e. {}; the derived entry is {}: a misprint (P² = P forces this entry to be 1)",
+            x.row + 1,
+            x.col + 1,
+            r.prefactor.as_deref().unwrap_or(""),
+            x.reference,
+            x.derived
+        );
+    }
+    for x in &other {
+        println!(
+            "  entry ({},{}) DIFFERS: reference {}, derived {}",
+            x.row + 1,
+            x.col + 1,
+            x.reference,
+            x.derived
+        );
+    }
+    if c.has_collision {
+        if c.collision.is_empty() {
+            println!("collision law: agrees with the paper's theorem in every component");
+        }
+        for x in &c.collision {
+            println!(
+                "  collision component {} DIFFERS: reference {}, derived {}",
+                x.row + 1,
+                x.reference,
+                x.derived
+            );
+        }
+    }
+    let ok = other.is_empty() && c.collision.is_empty();
+    println!(
+        "verdict: {}",
+        if ok && known.is_empty() {
+            "agrees with the paper".to_string()
+        } else if ok {
+            format!(
+                "agrees with the paper except {} misprinted diagonal entr{} of the printed P",
+                known.len(),
+                if known.len() == 1 { "y" } else { "ies" }
+            )
+        } else {
+            "DISAGREES with the reference".to_string()
+        }
+    );
+    ok
+}

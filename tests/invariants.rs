@@ -1,0 +1,256 @@
+//! The paper's invariants on every generated model, at random parameters,
+//! configurations and velocities (property tests; no symbolic engine).
+//!
+//! P² = P, GP = PᵀG, AP = A, BP = B (Lemma 1); the collision map keeps the
+//! kinetic energy (2.10), maps ker A into ker A, reverses the wall's normal
+//! velocity and is an involution; the generated P equals the one computed
+//! numerically from G and B by the runtime's generic path.
+
+use dalembert::for_each_model;
+use dalembert::models::*;
+use dalembert::runtime::linalg::{kinetic_energy, mat_mul, mat_vec, projector};
+use dalembert::runtime::{Model, Rows};
+use nalgebra::DMatrix;
+use proptest::prelude::*;
+use proptest::test_runner::{Config, TestRunner};
+
+/// Tolerance relative to the size of the quantities compared.
+const TOL: f64 = 1e-9;
+
+fn close(a: f64, b: f64, scale: f64) -> bool {
+    (a - b).abs() <= TOL * (1.0 + scale)
+}
+
+fn max_abs<const N: usize>(m: &[[f64; N]; N]) -> f64 {
+    m.iter().flatten().fold(0.0, |x, y| x.max(y.abs()))
+}
+
+/// Projects v onto ker A (Euclidean; membership in ker A does not depend on
+/// the metric).
+fn onto_kernel<const N: usize>(a: &Rows<N>, v: [f64; N]) -> [f64; N] {
+    let k = a.len();
+    if k == 0 {
+        return v;
+    }
+    let am = DMatrix::from_fn(k, N, |i, j| a.as_slice()[i][j]);
+    let vv = DMatrix::from_fn(N, 1, |i, _| v[i]);
+    let aat = &am * am.transpose();
+    let lam = aat.lu().solve(&(&am * &vv)).expect("A has full row rank");
+    let w = vv - am.transpose() * lam;
+    std::array::from_fn(|i| w[(i, 0)])
+}
+
+/// Checks every invariant for one model instance at (q, v).
+fn check<M: Model<Q, N>, const Q: usize, const N: usize>(
+    model: &M,
+    q: &[f64; Q],
+    v: [f64; N],
+) -> Result<(), TestCaseError> {
+    let g = model.mass_matrix(q);
+    let a = model.constraints(q);
+    let v = onto_kernel(&a, v);
+    for &wall in M::WALLS {
+        let name = M::wall_name(wall);
+        let p = model.projector(wall, q);
+        let scale = max_abs(&p);
+        // P² = P
+        let p2 = mat_mul(&p, &p);
+        for i in 0..N {
+            for j in 0..N {
+                prop_assert!(
+                    close(p2[i][j], p[i][j], scale * scale),
+                    "{} {name}: P² ≠ P at ({i},{j})",
+                    M::NAME
+                );
+            }
+        }
+        // GP = PᵀG
+        let gp = mat_mul(&g, &p);
+        let gs = max_abs(&g) * scale;
+        for i in 0..N {
+            for j in 0..N {
+                let ptg: f64 = (0..N).map(|k| p[k][i] * g[k][j]).sum();
+                prop_assert!(
+                    close(gp[i][j], ptg, gs),
+                    "{} {name}: GP ≠ PᵀG at ({i},{j})",
+                    M::NAME
+                );
+            }
+        }
+        // AP = A and BP = B
+        let b = model.wall_rows(wall, q);
+        for (what, rows) in [("A", &a), ("B", &b)] {
+            for row in rows.as_slice() {
+                for j in 0..N {
+                    let rp: f64 = (0..N).map(|k| row[k] * p[k][j]).sum();
+                    prop_assert!(
+                        close(
+                            rp,
+                            row[j],
+                            scale * row.iter().fold(0.0, |m, x| m.max(x.abs()))
+                        ),
+                        "{} {name}: {what}P ≠ {what} in column {j}",
+                        M::NAME
+                    );
+                }
+            }
+        }
+        // The generic numeric path gives the same P.
+        let p_generic =
+            projector(&g, b.as_slice()).map_err(|e| TestCaseError::fail(format!("{e:?}")))?;
+        for i in 0..N {
+            for j in 0..N {
+                prop_assert!(
+                    (p_generic[i][j] - p[i][j]).abs() <= 1e-7 * (1.0 + scale),
+                    "{} {name}: generated P differs from the generic path at ({i},{j}): {} vs {}",
+                    M::NAME,
+                    p[i][j],
+                    p_generic[i][j]
+                );
+            }
+        }
+        // The collision map.
+        let vp = model.collide(wall, q, &v);
+        let e0 = kinetic_energy(&g, &v);
+        let e1 = kinetic_energy(&g, &vp);
+        prop_assert!(
+            close(e0, e1, e0.abs()),
+            "{} {name}: energy not kept: {e0} → {e1}",
+            M::NAME
+        );
+        prop_assert!(
+            close(model.kinetic_energy(q, &v), e0, e0.abs()),
+            "{} {name}: T(q,v) ≠ ½vᵀGv",
+            M::NAME
+        );
+        let vmax = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        prop_assert!(
+            a.apply(&vp).max_abs() <= TOL * (1.0 + vmax * 10.0),
+            "{} {name}: v⁺ ∉ ker A",
+            M::NAME
+        );
+        let n0 = model.normal_velocity(wall, q, &v);
+        let n1 = model.normal_velocity(wall, q, &vp);
+        prop_assert!(
+            close(n1, -n0, vmax),
+            "{} {name}: normal velocity {n0} → {n1}, not reversed",
+            M::NAME
+        );
+        let back = model.collide(wall, q, &vp);
+        for i in 0..N {
+            prop_assert!(
+                close(back[i], v[i], vmax),
+                "{} {name}: the collision map is not an involution",
+                M::NAME
+            );
+        }
+        // Same as (I − 2P)v computed from P.
+        let pv = mat_vec(&p, &v);
+        for i in 0..N {
+            prop_assert!(
+                close(vp[i], v[i] - 2.0 * pv[i], vmax * (1.0 + scale)),
+                "{} {name}: collide ≠ (I − 2P)v",
+                M::NAME
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Random parameters (each the file's value times a factor in [1/2, 2]),
+/// configurations in [0.2, 1.4] per coordinate (clear of the Euler angles'
+/// singularity at θ = 0) and velocities in [−3, 3].
+fn run<M: Model<Q, N>, const Q: usize, const N: usize>() {
+    let mut runner = TestRunner::new(Config {
+        cases: 512,
+        ..Config::default()
+    });
+    let np = M::PARAMETERS.len();
+    let strategy = (
+        proptest::collection::vec(0.5f64..2.0, np),
+        proptest::array::uniform::<_, Q>(0.2f64..1.4),
+        proptest::array::uniform::<_, N>(-3.0f64..3.0),
+    );
+    runner
+        .run(&strategy, |(factors, q, v)| {
+            let mut model = M::with_params(Default::default());
+            for (i, f) in factors.iter().enumerate() {
+                let x = model.parameter(i).unwrap_or(1.0);
+                model.set_parameter(i, x * f);
+            }
+            check(&model, &q, v)
+        })
+        .unwrap();
+}
+
+macro_rules! invariant_test {
+    ($module:ident, $ty:ident, $q:literal, $n:literal) => {
+        #[test]
+        fn $module() {
+            run::<$ty, $q, $n>();
+        }
+    };
+}
+
+for_each_model!(invariant_test);
+
+/// A model whose collision map reverses all of v: it keeps the energy and
+/// is an involution, but is not the reflection (I − 2P)v. `check` must reject it.
+struct Reversing(BallFloor);
+
+impl Model<0, 6> for Reversing {
+    type Params = ball_floor::Params;
+    type Wall = ball_floor::Wall;
+    const NAME: &'static str = "reversing";
+    const WALLS: &'static [ball_floor::Wall] = BallFloor::WALLS;
+    const COORDINATES: &'static [&'static str] = &[];
+    const VELOCITIES: &'static [&'static str] = BallFloor::VELOCITIES;
+    const PARAMETERS: &'static [&'static str] = BallFloor::PARAMETERS;
+    fn with_params(p: Self::Params) -> Self {
+        Self(BallFloor::with_params(p))
+    }
+    fn params(&self) -> &Self::Params {
+        &self.0.params
+    }
+    fn parameter(&self, i: usize) -> Option<f64> {
+        self.0.parameter(i)
+    }
+    fn set_parameter(&mut self, i: usize, x: f64) -> bool {
+        self.0.set_parameter(i, x)
+    }
+    fn wall_name(w: Self::Wall) -> &'static str {
+        BallFloor::wall_name(w)
+    }
+    fn mass_matrix(&self, q: &[f64; 0]) -> [[f64; 6]; 6] {
+        self.0.mass_matrix(q)
+    }
+    fn kinetic_energy(&self, q: &[f64; 0], v: &[f64; 6]) -> f64 {
+        self.0.kinetic_energy(q, v)
+    }
+    fn potential(&self, q: &[f64; 0]) -> f64 {
+        self.0.potential(q)
+    }
+    fn constraints(&self, q: &[f64; 0]) -> Rows<6> {
+        self.0.constraints(q)
+    }
+    fn surface(&self, w: Self::Wall, q: &[f64; 0]) -> f64 {
+        Model::surface(&self.0, w, q)
+    }
+    fn wall_rows(&self, w: Self::Wall, q: &[f64; 0]) -> Rows<6> {
+        self.0.wall_rows(w, q)
+    }
+    fn projector(&self, w: Self::Wall, q: &[f64; 0]) -> [[f64; 6]; 6] {
+        Model::projector(&self.0, w, q)
+    }
+    fn collide(&self, _: Self::Wall, _: &[f64; 0], v: &[f64; 6]) -> [f64; 6] {
+        v.map(|x| -x)
+    }
+}
+
+#[test]
+fn a_wrong_collision_map_is_caught() {
+    let wrong = Reversing(BallFloor::default());
+    let v = [0.3, -0.2, -1.0, 0.1, 0.4, 0.7];
+    assert!(check(&wrong, &[], v).is_err());
+    assert!(check(&BallFloor::default(), &[], v).is_ok());
+}

@@ -1,0 +1,85 @@
+//! Every generated function runs without touching the heap: a counting
+//! global allocator sees zero allocations while they run.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+use dalembert::for_each_model;
+use dalembert::models::*;
+use dalembert::runtime::Model;
+use dalembert::runtime::linalg::projector;
+
+struct Counting;
+
+thread_local! {
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.with(|a| a.set(a.get() + 1));
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new: usize) -> *mut u8 {
+        ALLOCATIONS.with(|a| a.set(a.get() + 1));
+        unsafe { System.realloc(ptr, layout, new) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn allocations_during(f: impl FnOnce()) -> usize {
+    let before = ALLOCATIONS.with(Cell::get);
+    f();
+    ALLOCATIONS.with(Cell::get) - before
+}
+
+/// Calls every function of the model's trait (and the runtime's generic
+/// projector) and returns a checksum so nothing is optimised away.
+fn exercise<M: Model<Q, N>, const Q: usize, const N: usize>(m: &M) -> f64 {
+    let q: [f64; Q] = std::array::from_fn(|i| 0.4 + 0.1 * i as f64);
+    let v: [f64; N] = std::array::from_fn(|i| 0.3 - 0.2 * i as f64);
+    let mut s = m.energy(&q, &v) + m.mass_matrix(&q)[0][0];
+    s += m.constraints(&q).apply(&v).max_abs();
+    for &w in M::WALLS {
+        s += m.surface(w, &q);
+        s += m.wall_rows(w, &q).as_slice().len() as f64;
+        s += m.projector(w, &q)[0][0];
+        s += m.collide(w, &q, &v)[0];
+        s += m.normal_velocity(w, &q, &v);
+        let g = m.mass_matrix(&q);
+        if let Ok(p) = projector(&g, m.wall_rows(w, &q).as_slice()) {
+            s += p[0][0];
+        }
+    }
+    s
+}
+
+macro_rules! no_alloc_test {
+    ($module:ident, $ty:ident, $q:literal, $n:literal) => {
+        #[test]
+        fn $module() {
+            let model = <$ty as Model<$q, $n>>::with_params(Default::default());
+            let mut sum = 0.0;
+            let n = allocations_during(|| sum = exercise::<$ty, $q, $n>(&model));
+            assert!(sum.is_finite());
+            assert_eq!(n, 0, "{} allocated {n} times", stringify!($ty));
+        }
+    };
+}
+
+for_each_model!(no_alloc_test);
+
+/// The counter works: a heap allocation is seen.
+#[test]
+fn the_counter_sees_allocations() {
+    let n = allocations_during(|| {
+        let v = std::hint::black_box(vec![1.0_f64; 16]);
+        assert_eq!(v.len(), 16);
+    });
+    assert!(n >= 1);
+}

@@ -1,0 +1,232 @@
+//! Exact checks against Treschev & Zubelevich, and the generated numeric code
+//! against the symbolic results. These tests use the symbolic engine: run
+//! them one at a time (`RUST_TEST_THREADS=1`, as the README's command does).
+
+use std::path::{Path, PathBuf};
+
+use dalembert::for_each_model;
+use dalembert::models::*;
+use dalembert::runtime::Model;
+use dalembert::runtime::linalg::{mat_mul, mat_vec};
+use dalembert_codegen::reference::{Difference, Reference};
+use dalembert_codegen::symbolic::{eval, same, substitute};
+use dalembert_codegen::{Derivation, derive};
+
+fn model_file(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("models")
+        .join(format!("{name}.toml"))
+}
+
+fn derived(name: &str) -> Derivation {
+    derive(&model_file(name)).unwrap_or_else(|e| panic!("{}", e.render()))
+}
+
+fn compare(name: &str) -> (Derivation, Reference, Vec<Difference>, Vec<Difference>) {
+    let d = derived(name);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("models/reference")
+        .join(format!("{name}.toml"));
+    let r = Reference::load(&path).unwrap();
+    let c = r.compare(&d).unwrap();
+    (d, r, c.projector, c.collision)
+}
+
+fn positions(diffs: &[Difference]) -> Vec<(usize, usize)> {
+    diffs.iter().map(|d| (d.row, d.col)).collect()
+}
+
+/// §3.1: the derived P equals the printed one except the diagonal entries
+/// (1,1) and (4,4). The paper prints "1" inside the prefactor 1/(2J̃), which
+/// reads as 1/(2J̃); the true entries are 1 (the rows (1,0,0,0,0) and
+/// (0,0,0,1,0) of B are G-orthogonal to the rest, so P fixes e₁ and e₄).
+#[test]
+fn section_3_1_projector_matches_paper_up_to_the_misprint() {
+    let (_, _, p, law) = compare("ball_wall");
+    assert_eq!(positions(&p), vec![(0, 0), (3, 3)], "{p:#?}");
+    for d in &p {
+        assert!(
+            same(&d.derived, "1").unwrap(),
+            "entry {:?} is {}",
+            (d.row, d.col),
+            d.derived
+        );
+        assert!(!same(&d.reference, "1").unwrap());
+    }
+    assert!(law.is_empty(), "Theorem 3.1 fails: {law:#?}");
+}
+
+/// §3.2: the derived P equals the printed one except entry (3,3): the paper
+/// prints "1" inside the prefactor 1/J′; the true entry is 1 (P e₃ = e₃).
+#[test]
+fn section_3_2_projector_matches_paper_up_to_the_misprint() {
+    let (_, _, p, law) = compare("ball_floor");
+    assert_eq!(positions(&p), vec![(2, 2)], "{p:#?}");
+    assert!(same(&p[0].derived, "1").unwrap());
+    assert!(law.is_empty(), "Theorem 3.2 fails: {law:#?}");
+}
+
+/// The comparison can fail: a wrong reference entry is reported.
+#[test]
+fn a_wrong_reference_entry_is_reported() {
+    let d = derived("ball_floor");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/reference/ball_floor.toml");
+    let mut r = Reference::load(&path).unwrap();
+    r.projector[0][4] = "J*r".into(); // sign flipped
+    r.collision[2] = "v3".into(); // no reversal
+    let c = r.compare(&d).unwrap();
+    assert_eq!(positions(&c.projector), vec![(0, 4), (2, 2)]);
+    assert_eq!(positions(&c.collision), vec![(2, 0)]);
+}
+
+/// §3.2.1: v⁻ = (−v, 0, −u), ω⁻ = (0, rmv/J, 0) maps to v⁺ = −v⁻, ω⁺ = −ω⁻,
+/// exactly, for all m, r, J, u, v.
+#[test]
+fn section_3_2_1_pendulum_data_is_reversed() {
+    let d = derived("ball_floor");
+    let w = &d.walls[0];
+    let data = [
+        ("v1", "-v"),
+        ("v2", "0"),
+        ("v3", "-u"),
+        ("w1", "0"),
+        ("w2", "r*m*v/J"),
+        ("w3", "0"),
+    ];
+    for (k, c) in w.collision.iter().enumerate() {
+        let after = substitute(c, &data).unwrap();
+        let expected = format!("-({})", data[k].1);
+        assert!(
+            same(&after, &expected).unwrap(),
+            "component {k}: {after} ≠ {expected}"
+        );
+    }
+}
+
+/// The §3.1 ball in Euler angles: at θ = π/2, φ = ψ = 0 its P, after the
+/// change of velocities (v1, v2, w1, w2, w3) = (ẋ, ẏ, θ̇, −ψ̇, φ̇), is the
+/// instantaneous model's P (which the test above ties to the paper).
+#[test]
+fn euler_angle_ball_agrees_with_the_paper_model() {
+    let euler = BallWallEuler::default();
+    let inst = BallWall::default();
+    let q = [0.5, 0.0, 0.0, std::f64::consts::FRAC_PI_2, 0.0];
+    // S: q̇ = (ẋ, ẏ, φ̇, θ̇, ψ̇) ↦ u = (v1, v2, w1, w2, w3).
+    let s = [
+        [1.0, 0.0, 0.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0, 0.0, 0.0],
+        [0.0, 0.0, 0.0, 1.0, 0.0],
+        [0.0, 0.0, 0.0, 0.0, -1.0],
+        [0.0, 0.0, 1.0, 0.0, 0.0],
+    ];
+    // S is a signed permutation: S⁻¹ = Sᵀ.
+    let s_inv: [[f64; 5]; 5] = std::array::from_fn(|i| std::array::from_fn(|j| s[j][i]));
+    let p_q = euler.wall_projector(&q);
+    let p_u = mat_mul(&mat_mul(&s, &p_q), &s_inv);
+    let p_paper = inst.wall_projector(&[]);
+    for i in 0..5 {
+        for j in 0..5 {
+            assert!(
+                (p_u[i][j] - p_paper[i][j]).abs() < 1e-12,
+                "({i},{j}): {} vs {}",
+                p_u[i][j],
+                p_paper[i][j]
+            );
+        }
+    }
+    // The collision maps agree on a velocity in ker A too.
+    let qd = [0.2, -0.6, 0.9, 1.2, -0.4];
+    let u = mat_vec(&s, &euler.wall_collide(&q, &qd));
+    let u2 = inst.wall_collide(&[], &mat_vec(&s, &qd));
+    for i in 0..5 {
+        assert!((u[i] - u2[i]).abs() < 1e-12);
+    }
+}
+
+/// A small deterministic generator for test points.
+fn lcg(state: &mut u64) -> f64 {
+    *state = state
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    (*state >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// The generated projector and collision map agree with symbolica's own
+/// evaluation of the symbolic P and (I − 2P)v at random parameters,
+/// configurations and velocities.
+fn numeric_agrees<M: Model<Q, N>, const Q: usize, const N: usize>(file: &str) {
+    let d = derived(file);
+    let mut seed = 7u64;
+    for _ in 0..5 {
+        let mut model = M::with_params(Default::default());
+        let mut values: Vec<(String, f64)> = Vec::new();
+        for (i, name) in M::PARAMETERS.iter().enumerate() {
+            let x = model.parameter(i).unwrap() * (0.5 + 1.5 * lcg(&mut seed));
+            model.set_parameter(i, x);
+            values.push((name.to_string(), x));
+        }
+        let q: [f64; Q] = std::array::from_fn(|_| 0.2 + 1.2 * lcg(&mut seed));
+        let v: [f64; N] = std::array::from_fn(|_| -2.0 + 4.0 * lcg(&mut seed));
+        values.extend(
+            M::COORDINATES
+                .iter()
+                .zip(q)
+                .map(|(n, x)| (n.to_string(), x)),
+        );
+        values.extend(M::VELOCITIES.iter().zip(v).map(|(n, x)| (n.to_string(), x)));
+        let refs: Vec<(&str, f64)> = values.iter().map(|(n, x)| (n.as_str(), *x)).collect();
+        for (w, wd) in M::WALLS.iter().zip(&d.walls) {
+            assert_eq!(M::wall_name(*w), wd.name);
+            let p = model.projector(*w, &q);
+            for i in 0..N {
+                for j in 0..N {
+                    let s = eval(&wd.projector[i][j], &refs).unwrap();
+                    assert!(
+                        (s - p[i][j]).abs() <= 1e-10 * (1.0 + s.abs()),
+                        "{file} P({i},{j}): symbolic {s}, generated {}",
+                        p[i][j]
+                    );
+                }
+            }
+            let vp = model.collide(*w, &q, &v);
+            for i in 0..N {
+                let s = eval(&wd.collision[i], &refs).unwrap();
+                assert!(
+                    (s - vp[i]).abs() <= 1e-10 * (1.0 + s.abs()),
+                    "{file} v⁺[{i}]: symbolic {s}, generated {}",
+                    vp[i]
+                );
+            }
+        }
+    }
+}
+
+macro_rules! numeric_test {
+    ($module:ident, $ty:ident, $q:literal, $n:literal) => {
+        #[test]
+        fn $module() {
+            numeric_agrees::<$ty, $q, $n>(stringify!($module));
+        }
+    };
+}
+
+mod generated_equals_symbolic {
+    use super::*;
+    for_each_model!(numeric_test);
+}
+
+/// sin² + cos² = 1 is reduced: no entry of the Euler-angle ball's P contains
+/// cos(θ) to a power above 1.
+#[test]
+fn trig_identity_is_reduced() {
+    let d = derived("ball_wall_euler");
+    for row in &d.walls[0].projector {
+        for e in row {
+            for k in 2..8 {
+                assert!(!e.contains(&format!("cos(theta)^{k}")), "{e}");
+                assert!(!e.contains(&format!("cos(phi)^{k}")), "{e}");
+                assert!(!e.contains(&format!("cos(psi)^{k}")), "{e}");
+            }
+        }
+    }
+}
