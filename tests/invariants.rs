@@ -22,7 +22,7 @@ fn close(a: f64, b: f64, scale: f64) -> bool {
 }
 
 fn max_abs<const N: usize>(m: &[[f64; N]; N]) -> f64 {
-    m.iter().flatten().fold(0.0, |x, y| x.max(y.abs()))
+    m.iter().flatten().fold(0.0_f64, |x, y| x.max(y.abs()))
 }
 
 /// Projects v onto ker A (Euclidean; membership in ker A does not depend on
@@ -87,7 +87,7 @@ fn check<M: Model<Q, N>, const Q: usize, const N: usize>(
                         close(
                             rp,
                             row[j],
-                            scale * row.iter().fold(0.0, |m, x| m.max(x.abs()))
+                            scale * row.iter().fold(0.0_f64, |m, x| m.max(x.abs()))
                         ),
                         "{} {name}: {what}P ≠ {what} in column {j}",
                         M::NAME

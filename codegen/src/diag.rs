@@ -86,7 +86,7 @@ pub enum ErrorKind {
         at: String,
     },
     /// A paper hypothesis fails for a wall.
-    #[error("wall `{wall}`: {condition} fails at {at}")]
+    #[error("wall `{wall}` breaks the paper's hypothesis {condition} (for {at})")]
     Hypothesis {
         /// The wall.
         wall: String,

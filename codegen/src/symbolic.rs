@@ -529,7 +529,7 @@ impl<'a> Deriver<'a> {
             self.cx.error(
                 ErrorKind::Hypothesis {
                     wall: w.name.clone(),
-                    condition: "ker A ⊄ TₓN (1.3): the constraints already forbid motion across the wall (or the normal velocity is zero)".into(),
+                    condition: "ker A ⊄ TₓN (1.3): the constraints already forbid motion across the wall, or its normal velocity is zero".into(),
                     at,
                 },
                 Some(w.span.clone()),
