@@ -62,7 +62,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Paper { models } => paper(&models),
-        Command::Derive { file } => derive(&file).map(|d| print_derivation(&d)),
+        Command::Derive { file } => derive_timed(&file),
         Command::Generate { file, output } => generate(&file, output.as_deref()),
         Command::Check { file, reference } => check(&file, &reference),
     };
@@ -78,6 +78,23 @@ fn main() -> ExitCode {
 
 fn derive(file: &Path) -> Result<Derivation, String> {
     dalembert_codegen::derive(file).map_err(|e: ModelErrors| e.render())
+}
+
+/// `derive`: the derivation, then how long derivation and emission took.
+fn derive_timed(file: &Path) -> Result<bool, String> {
+    let start = std::time::Instant::now();
+    let d = derive(file)?;
+    let derived = start.elapsed();
+    let code = dalembert_codegen::emit::file(&d);
+    let total = start.elapsed();
+    print_derivation(&d);
+    println!(
+        "generator time: derivation {:.1} ms, emission {:.1} ms ({} lines of Rust)",
+        derived.as_secs_f64() * 1e3,
+        (total - derived).as_secs_f64() * 1e3,
+        code.lines().count()
+    );
+    Ok(true)
 }
 
 fn generate(file: &Path, output: Option<&Path>) -> Result<bool, String> {

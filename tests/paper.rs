@@ -154,6 +154,7 @@ fn lcg(state: &mut u64) -> f64 {
 /// The generated projector and collision map agree with symbolica's own
 /// evaluation of the symbolic P and (I − 2P)v at random parameters,
 /// configurations and velocities.
+#[allow(clippy::needless_range_loop)]
 fn numeric_agrees<M: Model<Q, N>, const Q: usize, const N: usize>(file: &str) {
     let d = derived(file);
     let mut seed = 7u64;

@@ -372,7 +372,7 @@ fn slot(p: &Program, s: Slot) -> TokenStream {
 fn instr(p: &Program, ins: &Instr) -> TokenStream {
     let (dst, value) = match ins {
         Instr::Add(d, s) => (*d, join(s.iter().map(|&x| slot(p, x)), quote! { + })),
-        Instr::Mul(d, s) => (*d, join(s.iter().map(|&x| slot(p, x)), quote! { * })),
+        Instr::Mul(d, s) => (*d, product(p, s)),
         Instr::Pow(d, s, n) => (*d, pow(slot(p, *s), *n)),
         Instr::Fun(d, f, s) => {
             let f = format_ident!("{}", f.name());
@@ -383,6 +383,26 @@ fn instr(p: &Program, ins: &Instr) -> TokenStream {
     };
     let dst = slot(p, dst);
     quote! { let #dst: f64 = #value; }
+}
+
+/// A product; a factor −1 becomes a negation.
+fn product(p: &Program, factors: &[Slot]) -> TokenStream {
+    let minus_one = |s: &Slot| matches!(s, Slot::Const(i) if p.consts[*i] == -1.0);
+    let rest: Vec<Slot> = factors.iter().copied().filter(|s| !minus_one(s)).collect();
+    let negations = factors.len() - rest.len();
+    if rest.is_empty() {
+        return if negations % 2 == 1 {
+            quote! { -1.0 }
+        } else {
+            quote! { 1.0 }
+        };
+    }
+    let prod = join(rest.iter().map(|&x| slot(p, x)), quote! { * });
+    if negations % 2 == 1 {
+        quote! { -(#prod) }
+    } else {
+        prod
+    }
 }
 
 /// Operands joined by an operator: `a + b + c`.

@@ -640,16 +640,12 @@ impl Validator<'_> {
                         depth = 0;
                     }
                 }
-                Token::Call(n, r) => {
-                    if !FUNCTIONS.contains(&n) {
-                        self.cx.error(
-                            ErrorKind::UnknownFunction {
-                                name: n.to_string(),
-                            },
-                            at(&r),
-                        );
-                    }
-                }
+                Token::Call(n, r) if !FUNCTIONS.contains(&n) => self.cx.error(
+                    ErrorKind::UnknownFunction {
+                        name: n.to_string(),
+                    },
+                    at(&r),
+                ),
                 _ => {}
             }
         }

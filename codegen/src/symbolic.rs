@@ -183,6 +183,7 @@ impl<'a> Deriver<'a> {
         Some(a)
     }
 
+    #[allow(clippy::needless_range_loop)] // matrix code reads best with indices
     fn run(&mut self) -> Option<Derivation> {
         let m = self.model;
         let n = m.velocities.len();
@@ -192,7 +193,7 @@ impl<'a> Deriver<'a> {
             None => Atom::num(0),
         };
         if let Some(p) = &m.potential {
-            self.no_velocity(&v_atom, &p.span, |v| ErrorKind::VelocityInPotential(v));
+            self.no_velocity(&v_atom, &p.span, ErrorKind::VelocityInPotential);
         }
 
         // G = ∂²T/∂v∂v, and T must equal ½ vᵀ G v.
@@ -317,7 +318,7 @@ impl<'a> Deriver<'a> {
                 .map(|i| {
                     let mut s = Atom::from(self.vels[i]);
                     for j in 0..n {
-                        s = s - Atom::num(2) * p_atoms[i][j].clone() * Atom::from(self.vels[j]);
+                        s -= Atom::num(2) * p_atoms[i][j].clone() * Atom::from(self.vels[j]);
                     }
                     s
                 })
@@ -395,7 +396,7 @@ impl<'a> Deriver<'a> {
         let mut quad = Atom::num(0);
         for (i, vi) in self.vels.iter().enumerate() {
             for (j, vj) in self.vels.iter().enumerate() {
-                quad = quad + g[i][j].clone() * Atom::from(*vi) * Atom::from(*vj);
+                quad += g[i][j].clone() * Atom::from(*vi) * Atom::from(*vj);
             }
         }
         let rest = (t.clone() - quad / Atom::num(2)).expand();
@@ -433,7 +434,7 @@ impl<'a> Deriver<'a> {
         }
         let mut lin = Atom::num(0);
         for (c, v) in row.iter().zip(&self.vels) {
-            lin = lin + c.clone() * Atom::from(*v);
+            lin += c.clone() * Atom::from(*v);
         }
         let rest = (e.clone() - lin).expand();
         if !is_zero(&rest) {
