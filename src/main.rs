@@ -12,6 +12,7 @@ use clap::{Parser, Subcommand};
 use dalembert::models::BallFloor;
 use dalembert::runtime::Model;
 use dalembert_codegen::reference::{Comparison, Reference};
+use dalembert_codegen::symbolic;
 use dalembert_codegen::{Derivation, ModelErrors};
 
 const MODELS_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/models");
@@ -40,6 +41,9 @@ enum Command {
     Derive {
         /// The model file.
         file: PathBuf,
+        /// Print LaTeX (pmatrix environments) instead of plain text.
+        #[arg(long)]
+        latex: bool,
     },
     /// Write the generated Rust code for a model file.
     Generate {
@@ -62,7 +66,8 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Paper { models } => paper(&models),
-        Command::Derive { file } => derive_timed(&file),
+        Command::Derive { file, latex: false } => derive_timed(&file),
+        Command::Derive { file, latex: true } => derive(&file).and_then(|d| print_latex(&d)),
         Command::Generate { file, output } => generate(&file, output.as_deref()),
         Command::Check { file, reference } => check(&file, &reference),
     };
@@ -152,6 +157,48 @@ fn pendulum_demo() {
     );
 }
 
+/// A matrix as a LaTeX `pmatrix`.
+fn latex_matrix(m: &[Vec<String>]) -> Result<String, String> {
+    let mut rows = Vec::new();
+    for row in m {
+        let cells: Result<Vec<String>, String> = row.iter().map(|e| symbolic::latex(e)).collect();
+        rows.push(cells?.join(" & "));
+    }
+    Ok(format!(
+        "\\begin{{pmatrix}}\n  {}\n\\end{{pmatrix}}",
+        rows.join(" \\\\\n  ")
+    ))
+}
+
+/// `derive --latex`: G, A and, per wall, B, P and the collision law.
+fn print_latex(d: &Derivation) -> Result<bool, String> {
+    let m = &d.model;
+    println!(
+        "% model `{}`: velocities ({})",
+        m.name,
+        m.velocities.join(", ")
+    );
+    println!("G = {}", latex_matrix(&d.mass_matrix)?);
+    if !d.constraint_rows.is_empty() {
+        println!("A = {}", latex_matrix(&d.constraint_rows)?);
+    }
+    for w in &d.walls {
+        println!("% wall `{}`", w.name);
+        println!("B = {}", latex_matrix(&w.b_rows)?);
+        println!("P = {}", latex_matrix(&w.projector)?);
+        println!("\\begin{{aligned}}");
+        for (name, c) in m.velocities.iter().zip(&w.collision) {
+            println!(
+                "  {}^+ &= {} \\\\",
+                symbolic::latex(name)?,
+                symbolic::latex(c)?
+            );
+        }
+        println!("\\end{{aligned}}");
+    }
+    Ok(true)
+}
+
 fn print_matrix(title: &str, m: &[Vec<String>]) {
     println!("{title}");
     for row in m {
@@ -205,7 +252,7 @@ fn report(d: &Derivation, r: &Reference, c: &Comparison) -> bool {
     let misprint = |i: usize, j: usize| {
         r.prefactor.is_some()
             && r.projector[i][j].trim() == "1"
-            && dalembert_codegen::symbolic::same(
+            && symbolic::same(
                 &c.projector
                     .iter()
                     .find(|x| x.row == i && x.col == j)

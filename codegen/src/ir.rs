@@ -63,7 +63,7 @@ struct Header {
 #[serde(untagged)]
 enum ParamDecl {
     Full {
-        value: Number,
+        value: Option<Number>,
         #[serde(default)]
         doc: String,
     },
@@ -333,22 +333,32 @@ impl Validator<'_> {
         for (name, decl) in decls {
             self.declare(name, "parameter");
             let (value, span, doc) = match decl.get_ref() {
-                ParamDecl::Full { value, doc } => (value, decl.span(), doc.clone()),
-                ParamDecl::Bare(v) => (v, decl.span(), String::new()),
+                ParamDecl::Full { value, doc } => (value.as_ref(), decl.span(), doc.clone()),
+                ParamDecl::Bare(v) => (Some(v), decl.span(), String::new()),
             };
-            match rational(value) {
+            let value = value.ok_or_else(|| "it has no value: write `value = \"…\"`".to_string());
+            match value.and_then(rational) {
                 Ok(value) => out.push(Param {
                     name: name.get_ref().clone(),
                     value,
                     doc,
                 }),
-                Err(why) => self.cx.error(
-                    ErrorKind::BadParameter {
+                Err(why) => {
+                    self.cx.error(
+                        ErrorKind::BadParameter {
+                            name: name.get_ref().clone(),
+                            why,
+                        },
+                        Some(span),
+                    );
+                    // Still declared, so its uses are not reported as unknown;
+                    // the model is rejected anyway.
+                    out.push(Param {
                         name: name.get_ref().clone(),
-                        why,
-                    },
-                    Some(span),
-                ),
+                        value: Rational { num: 0, den: 1 },
+                        doc,
+                    });
+                }
             }
         }
         out

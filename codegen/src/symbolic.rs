@@ -719,7 +719,14 @@ impl<'a> Deriver<'a> {
             if is_zero(&coeff) {
                 continue;
             }
-            terms.push(format!("({coeff})*{}", self.model.velocities[k]));
+            let name = &self.model.velocities[k];
+            if is_zero(&(coeff.clone() - Atom::num(1))) {
+                terms.push(name.clone());
+            } else if is_zero(&(coeff.clone() + Atom::num(1))) {
+                terms.push(format!("-{name}"));
+            } else {
+                terms.push(format!("({coeff})*{name}"));
+            }
         }
         if terms.is_empty() {
             "0".into()
@@ -876,4 +883,11 @@ pub fn substitute(expr: &str, subs: &[(&str, &str)]) -> Result<String, String> {
         e = e.replace(Atom::from(symbol!(*name))).with(v);
     }
     Ok(e.to_string())
+}
+
+/// `expr` typeset as LaTeX by symbolica's printer.
+pub fn latex(expr: &str) -> Result<String, String> {
+    crate::lock::acquire()?;
+    let e = try_parse!(expr)?;
+    Ok(format!("{}", e.printer(PrintOptions::latex())))
 }

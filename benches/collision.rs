@@ -1,0 +1,161 @@
+//! Collision maps of the paper's models, side by side in one run:
+//!
+//! - `generated`: the code dalembert generates from `models/ball_*.toml`;
+//! - `hand`: the paper's closed forms (Theorems 3.1 and 3.2) written by hand,
+//!   recomputing the parameter combinations on every call as generated code does;
+//! - `generic_static`: P from G and B by the runtime's heap-free generic path
+//!   (Cholesky + Gram–Schmidt on fixed-size arrays), then (I − 2P)v;
+//! - `generic_dynamic`: P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B with nalgebra's heap-allocated
+//!   dynamic matrices on every call, then (I − 2P)v.
+//!
+//! Run: `cargo bench --bench collision`.
+
+use std::hint::black_box;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use dalembert::models::{BallFloor, BallWall};
+use dalembert::runtime::Model;
+use dalembert::runtime::linalg::{projector, reflect};
+use nalgebra::{DMatrix, DVector};
+
+/// Theorem 3.1 for admissible v = (v1, v2, w1, w2, w3), with w1, w2 of v⁺ from
+/// the rolling constraints (3.1).
+fn hand_3_1(m: f64, r: f64, j: f64, v: &[f64; 5]) -> [f64; 5] {
+    let jt = j + 0.5 * r * r * m; // J~
+    let jp = j + r * r * m; // J'
+    let inv = 1.0 / jt;
+    let a = 0.5 * r * r * m * inv;
+    let v1 = -v[0];
+    let v2 = a * v[1] + r * j * inv * v[4];
+    let w3 = jp * inv / r * v[1] - a * v[4];
+    [v1, v2, -v2 / r, v1 / r, w3]
+}
+
+/// Theorem 3.2.
+fn hand_3_2(m: f64, r: f64, j: f64, v: &[f64; 6]) -> [f64; 6] {
+    let inv = 1.0 / (j + r * r * m); // 1/J'
+    let a = (m * r * r - j) * inv;
+    let b = 2.0 * j * r * inv;
+    let c = 2.0 * r * m * inv;
+    [
+        a * v[0] + b * v[4],
+        a * v[1] - b * v[3],
+        -v[2],
+        -c * v[1] - a * v[3],
+        c * v[0] - a * v[4],
+        v[5],
+    ]
+}
+
+/// P from G and B with dynamic matrices, then (I − 2P)v.
+fn generic_dynamic(g: &DMatrix<f64>, b: &DMatrix<f64>, v: &DVector<f64>) -> DVector<f64> {
+    let g_inv = g.clone().cholesky().expect("G > 0").inverse();
+    let x = &g_inv * b.transpose();
+    let m = b * &x;
+    let p = x * m.try_inverse().expect("B full rank") * b;
+    v - 2.0 * p * v
+}
+
+fn dynamic_inputs<M: Model<0, N>, const N: usize>(
+    model: &M,
+    wall: M::Wall,
+) -> (DMatrix<f64>, DMatrix<f64>) {
+    let g = model.mass_matrix(&[]);
+    let rows = model.wall_rows(wall, &[]);
+    let gd = DMatrix::from_fn(N, N, |i, j| g[i][j]);
+    let bd = DMatrix::from_fn(rows.len(), N, |i, j| rows.as_slice()[i][j]);
+    (gd, bd)
+}
+
+fn section_3_1(c: &mut Criterion) {
+    let ball = BallWall::default();
+    let p = ball.params;
+    let wall = BallWall::WALLS[0];
+    // An admissible velocity: w1 = -v2/r, w2 = v1/r.
+    let v = [-0.7, 0.4, -0.4 / p.r, -0.7 / p.r, 1.3];
+    // The three paths agree before they are timed.
+    let a = ball.wall_collide(&[], &v);
+    let b = hand_3_1(p.m, p.r, p.J, &v);
+    for i in 0..5 {
+        assert!(
+            (a[i] - b[i]).abs() < 1e-12,
+            "hand-written §3.1 differs at {i}"
+        );
+    }
+    let mut group = c.benchmark_group("collision_3_1");
+    group.bench_function("generated", |bch| {
+        bch.iter(|| black_box(&ball).wall_collide(&[], black_box(&v)))
+    });
+    group.bench_function("hand", |bch| {
+        bch.iter(|| {
+            hand_3_1(
+                black_box(p.m),
+                black_box(p.r),
+                black_box(p.J),
+                black_box(&v),
+            )
+        })
+    });
+    group.bench_function("generic_static", |bch| {
+        bch.iter(|| {
+            let m = black_box(&ball);
+            let g = m.mass_matrix(&[]);
+            let rows = m.wall_rows(wall, &[]);
+            let p = projector(&g, rows.as_slice()).expect("P");
+            reflect(&p, black_box(&v))
+        })
+    });
+    let (g, bm) = dynamic_inputs(&ball, wall);
+    let vd = DVector::from_row_slice(&v);
+    group.bench_function("generic_dynamic", |bch| {
+        bch.iter(|| generic_dynamic(black_box(&g), black_box(&bm), black_box(&vd)))
+    });
+    group.finish();
+}
+
+fn section_3_2(c: &mut Criterion) {
+    let ball = BallFloor::default();
+    let p = ball.params;
+    let wall = BallFloor::WALLS[0];
+    let v = [-1.5, 0.3, -2.0, 0.2, 7.5, -0.4];
+    let a = ball.floor_collide(&[], &v);
+    let b = hand_3_2(p.m, p.r, p.J, &v);
+    for i in 0..6 {
+        assert!(
+            (a[i] - b[i]).abs() < 1e-12,
+            "hand-written §3.2 differs at {i}"
+        );
+    }
+    let mut group = c.benchmark_group("collision_3_2");
+    group.bench_function("generated", |bch| {
+        bch.iter(|| black_box(&ball).floor_collide(&[], black_box(&v)))
+    });
+    group.bench_function("hand", |bch| {
+        bch.iter(|| {
+            hand_3_2(
+                black_box(p.m),
+                black_box(p.r),
+                black_box(p.J),
+                black_box(&v),
+            )
+        })
+    });
+    group.bench_function("generic_static", |bch| {
+        bch.iter(|| {
+            let m = black_box(&ball);
+            let g = m.mass_matrix(&[]);
+            let rows = m.wall_rows(wall, &[]);
+            let p = projector(&g, rows.as_slice()).expect("P");
+            reflect(&p, black_box(&v))
+        })
+    });
+    let (g, bm) = dynamic_inputs(&ball, wall);
+    let vd = DVector::from_row_slice(&v);
+    group.bench_function("generic_dynamic", |bch| {
+        bch.iter(|| generic_dynamic(black_box(&g), black_box(&bm), black_box(&vd)))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, section_3_1, section_3_2);
+criterion_main!(benches);
