@@ -197,7 +197,7 @@ fn wall_fns(d: &Derivation, w: &WallDerivation) -> TokenStream {
     );
     let rows = fn_rows(
         d,
-        &format!("{name}_rows"),
+        &format!("{name}_b_rows"),
         &format!("Wall `{name}`: the independent rows of B(q), the normal velocity first."),
         &w.programs.rows,
         w.b_rows.len(),
@@ -460,7 +460,7 @@ fn trait_impl(d: &Derivation) -> TokenStream {
         quote! { match wall { #(#arms,)* } }
     };
     let surface = per_wall("surface", quote! { q });
-    let rows = per_wall("rows", quote! { q });
+    let rows = per_wall("b_rows", quote! { q });
     let projector = per_wall("projector", quote! { q });
     let collide = per_wall("collide", quote! { q, v });
     quote! {
@@ -554,7 +554,7 @@ pub fn op_counts(d: &Derivation) -> Vec<(String, OpCount)> {
     ];
     for w in &d.walls {
         out.push((format!("{}_surface", w.name), w.programs.surface.op_count()));
-        out.push((format!("{}_rows", w.name), w.programs.rows.op_count()));
+        out.push((format!("{}_b_rows", w.name), w.programs.rows.op_count()));
         out.push((
             format!("{}_projector", w.name),
             w.programs.projector.op_count(),
