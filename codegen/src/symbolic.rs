@@ -314,6 +314,9 @@ impl<'a> Deriver<'a> {
                 .iter()
                 .map(|(r, _)| r.iter().map(|x| self.raise(&x.to_expression())).collect())
                 .collect();
+            if m.kind == Kind::Coordinates {
+                self.check_on_wall(w, &surface, &normal, &a_rows, &b_atoms);
+            }
             let collide: Vec<Atom> = (0..n)
                 .map(|i| {
                     let mut s = Atom::from(self.vels[i]);
@@ -538,6 +541,103 @@ impl<'a> Deriver<'a> {
         }
     }
 
+    /// (1.3) and B's rank at a point of the wall itself: the sample
+    /// configuration moved onto N = {f = 0} by Newton steps along ∇f, at the
+    /// file's parameter values. Catches models that satisfy the hypotheses for
+    /// generic q but break them on N.
+    fn check_on_wall(
+        &mut self,
+        w: &crate::ir::Wall,
+        surface: &Atom,
+        normal: &[Atom],
+        a: &[Vec<Atom>],
+        b: &[Vec<Atom>],
+    ) {
+        let n = self.vels.len();
+        let inputs = self.inputs();
+        let mut outputs = vec![surface.clone()];
+        outputs.extend(normal.iter().cloned());
+        outputs.extend(a.iter().flatten().cloned());
+        outputs.extend(b.iter().flatten().cloned());
+        let Some(prog) = self.program(&outputs, &inputs) else {
+            return;
+        };
+        let np = self.params.len();
+        let mut x = self.sample_inputs();
+        let mut on_wall = false;
+        for _ in 0..100 {
+            let out = prog.eval(&x);
+            let f = out[0];
+            let grad = &out[1..1 + n];
+            let g2: f64 = grad.iter().map(|g| g * g).sum();
+            let scale = 1.0 + x[np..np + n].iter().fold(0.0_f64, |m, q| m.max(q.abs()));
+            if f.abs() <= 1e-12 * scale {
+                on_wall = true;
+                break;
+            }
+            if !(g2 > 0.0) || !f.is_finite() {
+                break;
+            }
+            for k in 0..n {
+                x[np + k] -= f * grad[k] / g2;
+            }
+        }
+        if !on_wall {
+            // No point of N found near the sample: the generic checks stand.
+            return;
+        }
+        let out = prog.eval(&x);
+        let rows = |from: usize, count: usize| -> nalgebra::DMatrix<f64> {
+            nalgebra::DMatrix::from_fn(count, n, |i, j| out[from + i * n + j])
+        };
+        let normal_m = rows(1, 1);
+        let a_m = rows(1 + n, a.len());
+        let b_m = rows(1 + n + a.len() * n, b.len());
+        let stack = |p: &nalgebra::DMatrix<f64>, q: &nalgebra::DMatrix<f64>| {
+            let mut m = nalgebra::DMatrix::zeros(p.nrows() + q.nrows(), n);
+            m.rows_mut(0, p.nrows()).copy_from(p);
+            m.rows_mut(p.nrows(), q.nrows()).copy_from(q);
+            m
+        };
+        let at = {
+            let mut parts: Vec<String> = self
+                .model
+                .params
+                .iter()
+                .map(|p| format!("{} = {}", p.name, p.value))
+                .collect();
+            parts.extend(
+                self.model
+                    .coordinates
+                    .iter()
+                    .zip(&x[np..np + n])
+                    .map(|(c, q)| format!("{c} = {q:.6}")),
+            );
+            format!("the point {} of the wall", parts.join(", "))
+        };
+        let rb = numeric_rank(&b_m);
+        let mut failures = Vec::new();
+        if rb < b.len() {
+            failures.push("B of full row rank");
+        }
+        if numeric_rank(&stack(&b_m, &a_m)) > rb {
+            failures.push("ker B ⊆ ker A (1.3)");
+        }
+        if numeric_rank(&stack(&a_m, &normal_m)) == numeric_rank(&a_m) {
+            failures.push("ker A ⊄ TₓN (1.3): the constraints forbid motion across the wall there");
+        }
+        for condition in failures {
+            self.cx.error(
+                ErrorKind::Hypothesis {
+                    wall: w.name.clone(),
+                    condition: condition.into(),
+                    at: at.clone(),
+                },
+                Some(w.span.clone()),
+            );
+        }
+    }
+
     // ------------------------------------------------------------ functions
 
     /// Finds every application of a model function and gives it a symbol;
@@ -740,6 +840,16 @@ impl<'a> Deriver<'a> {
 /// (away from the usual coordinate singularities at 0 and π/2 multiples).
 pub fn sample_configuration(n: usize) -> Vec<f64> {
     (0..n).map(|i| 0.3 + 0.41 * i as f64).collect()
+}
+
+/// Rank by singular values, relative to the largest.
+fn numeric_rank(m: &nalgebra::DMatrix<f64>) -> usize {
+    if m.nrows() == 0 {
+        return 0;
+    }
+    let sv = m.clone().svd(false, false).singular_values;
+    let max = sv.iter().fold(0.0_f64, |a, b| a.max(*b));
+    sv.iter().filter(|s| **s > 1e-9 * max.max(1e-300)).count()
 }
 
 fn rows_matrix(rows: &[Vec<Rat>], n: usize, field: &Field) -> Option<Matrix<Field>> {
