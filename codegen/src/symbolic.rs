@@ -575,7 +575,7 @@ impl<'a> Deriver<'a> {
                 on_wall = true;
                 break;
             }
-            if !(g2 > 0.0) || !f.is_finite() {
+            if g2.is_nan() || g2 <= 0.0 || !f.is_finite() {
                 break;
             }
             for k in 0..n {
