@@ -49,7 +49,9 @@ enum Command {
     Generate {
         /// The model file.
         file: PathBuf,
-        /// Where to write it (default: standard output).
+        /// Where to write it (default: standard output). Prefer this to
+        /// redirecting standard output: symbolica prints its licence banner
+        /// there on first use.
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
