@@ -67,94 +67,60 @@ fn dynamic_inputs<M: Model<0, N>, const N: usize>(
     (gd, bd)
 }
 
-fn section_3_1(c: &mut Criterion) {
-    let ball = BallWall::default();
-    let p = ball.params;
-    let wall = BallWall::WALLS[0];
-    // An admissible velocity: w1 = -v2/r, w2 = v1/r.
-    let v = [-0.7, 0.4, -0.4 / p.r, -0.7 / p.r, 1.3];
-    // The three paths agree before they are timed.
-    let a = ball.wall_collide(&[], &v);
-    let b = hand_3_1(p.m, p.r, p.J, &v);
-    for i in 0..5 {
+/// The four paths for one instantaneous model's first wall, after checking
+/// that the generated and hand-written maps agree at `v`.
+fn compare<M: Model<0, N>, const N: usize>(
+    c: &mut Criterion,
+    group: &str,
+    model: &M,
+    v: [f64; N],
+    hand: impl Fn(&[f64; N]) -> [f64; N],
+) {
+    let wall = M::WALLS[0];
+    let generated = model.collide(wall, &[], &v);
+    let by_hand = hand(&v);
+    for i in 0..N {
         assert!(
-            (a[i] - b[i]).abs() < 1e-12,
-            "hand-written §3.1 differs at {i}"
+            (generated[i] - by_hand[i]).abs() < 1e-12,
+            "{group}: hand-written differs at {i}"
         );
     }
-    let mut group = c.benchmark_group("collision_3_1");
-    group.bench_function("generated", |bch| {
-        bch.iter(|| black_box(&ball).wall_collide(&[], black_box(&v)))
+    let mut g = c.benchmark_group(group);
+    g.bench_function("generated", |b| {
+        b.iter(|| black_box(model).collide(wall, &[], black_box(&v)))
     });
-    group.bench_function("hand", |bch| {
-        bch.iter(|| {
-            hand_3_1(
-                black_box(p.m),
-                black_box(p.r),
-                black_box(p.J),
-                black_box(&v),
-            )
-        })
-    });
-    group.bench_function("generic_static", |bch| {
-        bch.iter(|| {
-            let m = black_box(&ball);
-            let g = m.mass_matrix(&[]);
+    g.bench_function("hand", |b| b.iter(|| hand(black_box(&v))));
+    g.bench_function("generic_static", |b| {
+        b.iter(|| {
+            let m = black_box(model);
             let rows = m.wall_rows(wall, &[]);
-            let p = projector(&g, rows.as_slice()).expect("P");
+            let p = projector(&m.mass_matrix(&[]), rows.as_slice()).expect("P");
             reflect(&p, black_box(&v))
         })
     });
-    let (g, bm) = dynamic_inputs(&ball, wall);
+    let (gd, bd) = dynamic_inputs(model, wall);
     let vd = DVector::from_row_slice(&v);
-    group.bench_function("generic_dynamic", |bch| {
-        bch.iter(|| generic_dynamic(black_box(&g), black_box(&bm), black_box(&vd)))
+    g.bench_function("generic_dynamic", |b| {
+        b.iter(|| generic_dynamic(black_box(&gd), black_box(&bd), black_box(&vd)))
     });
-    group.finish();
+    g.finish();
+}
+
+fn section_3_1(c: &mut Criterion) {
+    let ball = BallWall::default();
+    let p = ball.params;
+    // An admissible velocity: w1 = -v2/r, w2 = v1/r.
+    let v = [-0.7, 0.4, -0.4 / p.r, -0.7 / p.r, 1.3];
+    let hand = |v: &[f64; 5]| hand_3_1(black_box(p.m), black_box(p.r), black_box(p.J), v);
+    compare(c, "collision_3_1", &ball, v, hand);
 }
 
 fn section_3_2(c: &mut Criterion) {
     let ball = BallFloor::default();
     let p = ball.params;
-    let wall = BallFloor::WALLS[0];
     let v = [-1.5, 0.3, -2.0, 0.2, 7.5, -0.4];
-    let a = ball.floor_collide(&[], &v);
-    let b = hand_3_2(p.m, p.r, p.J, &v);
-    for i in 0..6 {
-        assert!(
-            (a[i] - b[i]).abs() < 1e-12,
-            "hand-written §3.2 differs at {i}"
-        );
-    }
-    let mut group = c.benchmark_group("collision_3_2");
-    group.bench_function("generated", |bch| {
-        bch.iter(|| black_box(&ball).floor_collide(&[], black_box(&v)))
-    });
-    group.bench_function("hand", |bch| {
-        bch.iter(|| {
-            hand_3_2(
-                black_box(p.m),
-                black_box(p.r),
-                black_box(p.J),
-                black_box(&v),
-            )
-        })
-    });
-    group.bench_function("generic_static", |bch| {
-        bch.iter(|| {
-            let m = black_box(&ball);
-            let g = m.mass_matrix(&[]);
-            let rows = m.wall_rows(wall, &[]);
-            let p = projector(&g, rows.as_slice()).expect("P");
-            reflect(&p, black_box(&v))
-        })
-    });
-    let (g, bm) = dynamic_inputs(&ball, wall);
-    let vd = DVector::from_row_slice(&v);
-    group.bench_function("generic_dynamic", |bch| {
-        bch.iter(|| generic_dynamic(black_box(&g), black_box(&bm), black_box(&vd)))
-    });
-    group.finish();
+    let hand = |v: &[f64; 6]| hand_3_2(black_box(p.m), black_box(p.r), black_box(p.J), v);
+    compare(c, "collision_3_2", &ball, v, hand);
 }
 
 criterion_group!(benches, section_3_1, section_3_2);

@@ -599,22 +599,10 @@ impl<'a> Deriver<'a> {
             m.rows_mut(p.nrows(), q.nrows()).copy_from(q);
             m
         };
-        let at = {
-            let mut parts: Vec<String> = self
-                .model
-                .params
-                .iter()
-                .map(|p| format!("{} = {}", p.name, p.value))
-                .collect();
-            parts.extend(
-                self.model
-                    .coordinates
-                    .iter()
-                    .zip(&x[np..np + n])
-                    .map(|(c, q)| format!("{c} = {q:.6}")),
-            );
-            format!("the point {} of the wall", parts.join(", "))
-        };
+        let at = format!(
+            "the point {} of the wall",
+            self.point_description(&x[np..np + n])
+        );
         let rb = numeric_rank(&b_m);
         let mut failures = Vec::new();
         if rb < b.len() {
@@ -781,21 +769,27 @@ impl<'a> Deriver<'a> {
     }
 
     fn sample_description(&self) -> String {
-        let q = sample_configuration(self.coords.len());
-        let mut parts: Vec<String> = self
+        self.point_description(&sample_configuration(self.coords.len()))
+    }
+
+    /// "m = 1, r = 1/2, x = 0.3, …": the file's parameter values and `q`.
+    fn point_description(&self, q: &[f64]) -> String {
+        let trim = |x: &f64| {
+            let s = format!("{x:.6}");
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        };
+        let params = self
             .model
             .params
             .iter()
-            .map(|p| format!("{} = {}", p.name, p.value))
-            .collect();
-        parts.extend(
-            self.model
-                .coordinates
-                .iter()
-                .zip(q)
-                .map(|(n, x)| format!("{n} = {x}")),
-        );
-        parts.join(", ")
+            .map(|p| format!("{} = {}", p.name, p.value));
+        let coords = self
+            .model
+            .coordinates
+            .iter()
+            .zip(q)
+            .map(|(c, x)| format!("{c} = {}", trim(x)));
+        params.chain(coords).collect::<Vec<_>>().join(", ")
     }
 
     /// An optimised program for `outputs` in terms of `inputs`.
