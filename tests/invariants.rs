@@ -233,6 +233,12 @@ impl Model<0, 6> for Reversing {
     fn constraints(&self, q: &[f64; 0]) -> Rows<6> {
         self.0.constraints(q)
     }
+    fn forcing(&self, q: &[f64; 0], v: &[f64; 6]) -> [f64; 6] {
+        self.0.forcing(q, v)
+    }
+    fn constraint_drift(&self, q: &[f64; 0], v: &[f64; 6]) -> [f64; 6] {
+        self.0.constraint_drift(q, v)
+    }
     fn surface(&self, w: Self::Wall, q: &[f64; 0]) -> f64 {
         Model::surface(&self.0, w, q)
     }

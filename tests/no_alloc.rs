@@ -45,6 +45,7 @@ fn exercise<M: Model<Q, N>, const Q: usize, const N: usize>(m: &M) -> f64 {
     let v: [f64; N] = std::array::from_fn(|i| 0.3 - 0.2 * i as f64);
     let mut s = m.energy(&q, &v) + m.mass_matrix(&q)[0][0];
     s += m.constraints(&q).apply(&v).max_abs();
+    s += m.forcing(&q, &v)[0] + m.constraint_drift(&q, &v)[0];
     for &w in M::WALLS {
         s += m.surface(w, &q);
         s += m.wall_rows(w, &q).as_slice().len() as f64;

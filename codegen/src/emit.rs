@@ -163,6 +163,18 @@ fn inherent_impl(d: &Derivation) -> TokenStream {
         &d.programs.constraints,
         d.constraint_rows.len(),
     );
+    let forcing = fn_vector(
+        d,
+        "forcing",
+        "h(q, q̇): the equations of motion are G(q) q̈ + h(q, q̇) = A(q)ᵀλ (zero for an instantaneous model).",
+        &d.programs.forcing,
+    );
+    let drift = fn_padded(
+        d,
+        "constraint_drift",
+        "Ȧq̇, one entry per row of A (the rest zero): A q̈ + Ȧq̇ = 0 along the motion.",
+        &d.programs.constraint_drift,
+    );
     let walls = d.walls.iter().map(|w| wall_fns(d, w));
     let qn = Literal::usize_unsuffixed(q);
     let nn = Literal::usize_unsuffixed(n);
@@ -180,6 +192,8 @@ fn inherent_impl(d: &Derivation) -> TokenStream {
             #kinetic
             #potential
             #constraints
+            #forcing
+            #drift
             #( #walls )*
         }
     }
@@ -256,6 +270,30 @@ fn fn_vector(d: &Derivation, name: &str, doc: &str, p: &Program) -> TokenStream 
         #[inline]
         #[allow(unused_variables)]
         pub fn #f(&self, #args) -> [f64; #n] { #body [#(#outs),*] }
+    }
+}
+
+/// A function of (q, v) returning its k outputs padded with zeros to length n.
+fn fn_padded(d: &Derivation, name: &str, doc: &str, p: &Program) -> TokenStream {
+    let n = d.model.velocities.len();
+    let f = ident(name);
+    let args = args(d, true);
+    let body = body(d, p);
+    let outs = (0..n).map(|i| {
+        if i < p.outputs {
+            let o = format_ident!("o{i}");
+            quote! { #o }
+        } else {
+            quote! { 0.0 }
+        }
+    });
+    let nl = Literal::usize_unsuffixed(n);
+    let doc = doc_attr(doc);
+    quote! {
+        #doc
+        #[inline]
+        #[allow(unused_variables)]
+        pub fn #f(&self, #args) -> [f64; #nl] { #body [#(#outs),*] }
     }
 }
 
@@ -487,6 +525,8 @@ fn trait_impl(d: &Derivation) -> TokenStream {
             fn kinetic_energy(&self, q: &[f64; #ql], v: &[f64; #nl]) -> f64 { self.kinetic_energy(q, v) }
             fn potential(&self, q: &[f64; #ql]) -> f64 { self.potential(q) }
             fn constraints(&self, q: &[f64; #ql]) -> ::dalembert_runtime::Rows<#nl> { self.constraints(q) }
+            fn forcing(&self, q: &[f64; #ql], v: &[f64; #nl]) -> [f64; #nl] { self.forcing(q, v) }
+            fn constraint_drift(&self, q: &[f64; #ql], v: &[f64; #nl]) -> [f64; #nl] { self.constraint_drift(q, v) }
             fn surface(&self, wall: Wall, q: &[f64; #ql]) -> f64 { #surface }
             fn wall_rows(&self, wall: Wall, q: &[f64; #ql]) -> ::dalembert_runtime::Rows<#nl> { #rows }
             fn projector(&self, wall: Wall, q: &[f64; #ql]) -> [[f64; #nl]; #nl] { #projector }
@@ -551,6 +591,11 @@ pub fn op_counts(d: &Derivation) -> Vec<(String, OpCount)> {
         ),
         ("potential".to_string(), d.programs.potential.op_count()),
         ("constraints".to_string(), d.programs.constraints.op_count()),
+        ("forcing".to_string(), d.programs.forcing.op_count()),
+        (
+            "constraint_drift".to_string(),
+            d.programs.constraint_drift.op_count(),
+        ),
     ];
     for w in &d.walls {
         out.push((format!("{}_surface", w.name), w.programs.surface.op_count()));

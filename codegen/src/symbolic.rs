@@ -53,6 +53,10 @@ pub struct Programs {
     pub potential: Program,
     /// A (k·n outputs, row-major).
     pub constraints: Program,
+    /// h(q, q̇) of G q̈ + h = Aᵀλ (n outputs; zero for instantaneous models).
+    pub forcing: Program,
+    /// Ȧq̇, one output per row of A (zero for instantaneous models).
+    pub constraint_drift: Program,
 }
 
 /// Programs for one wall.
@@ -355,7 +359,10 @@ impl<'a> Deriver<'a> {
             .iter()
             .map(|r| r.iter().map(|a| self.reduce_atom(a, &vars)).collect())
             .collect();
+        let (forcing, drift) = self.equations_of_motion(&t, &v_atom, &a_rows);
         let programs = Programs {
+            forcing: self.program(&forcing, &inputs)?,
+            constraint_drift: self.program(&drift, &inputs)?,
             mass_matrix: self.program(
                 &g_simpl.iter().flatten().cloned().collect::<Vec<_>>(),
                 &inputs,
@@ -374,6 +381,49 @@ impl<'a> Deriver<'a> {
             walls,
             programs,
         })
+    }
+
+    /// The Lagrange–d'Alembert equations G q̈ + h = Aᵀλ with A q̇ = 0:
+    /// hᵢ = Σₖ ∂²T/∂q̇ᵢ∂qₖ q̇ₖ − ∂T/∂qᵢ + ∂V/∂qᵢ, and differentiating A q̇ = 0
+    /// in time gives A q̈ + Ȧq̇ = 0 with (Ȧq̇)ᵣ = Σⱼ ∂(Aᵣq̇)/∂qⱼ q̇ⱼ.
+    /// An instantaneous model has no motion between collisions: both are zero.
+    fn equations_of_motion(
+        &self,
+        t: &Atom,
+        v: &Atom,
+        a_rows: &[Vec<Atom>],
+    ) -> (Vec<Atom>, Vec<Atom>) {
+        let n = self.vels.len();
+        if self.model.kind == Kind::Instantaneous {
+            return (vec![Atom::num(0); n], vec![Atom::num(0); a_rows.len()]);
+        }
+        let qdot = |k: usize| Atom::from(self.vels[k]);
+        let forcing = (0..n)
+            .map(|i| {
+                let q = self.coords[i];
+                let ti = t.derivative(self.vels[i]);
+                let mut h = v.derivative(q) - t.derivative(q);
+                for (k, qk) in self.coords.iter().enumerate() {
+                    h += ti.derivative(*qk) * qdot(k);
+                }
+                h
+            })
+            .collect();
+        let drift = a_rows
+            .iter()
+            .map(|row| {
+                let mut e = Atom::num(0);
+                for (k, a) in row.iter().enumerate() {
+                    e += a.clone() * qdot(k);
+                }
+                let mut c = Atom::num(0);
+                for (j, qj) in self.coords.iter().enumerate() {
+                    c += e.derivative(*qj) * qdot(j);
+                }
+                c
+            })
+            .collect();
+        (forcing, drift)
     }
 
     // ------------------------------------------------------------ checks

@@ -14,6 +14,7 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod dynamics;
 pub mod linalg;
 
 /// Up to `N` rows of length `N`: a constraint matrix such as A(q) or B(q).
@@ -126,6 +127,12 @@ pub trait Model<const Q: usize, const N: usize> {
     fn potential(&self, q: &[f64; Q]) -> f64;
     /// Rows of the nonholonomic constraints A(q): admissible v have A v = 0.
     fn constraints(&self, q: &[f64; Q]) -> Rows<N>;
+    /// h(q, q̇) in the Lagrange–d'Alembert equations G(q) q̈ + h(q, q̇) = A(q)ᵀλ
+    /// (zero for an instantaneous model). See [`dynamics::accelerations`].
+    fn forcing(&self, q: &[f64; Q], v: &[f64; N]) -> [f64; N];
+    /// Ȧq̇, one entry per row of A, the rest zero: along the motion
+    /// A q̈ + Ȧq̇ = 0.
+    fn constraint_drift(&self, q: &[f64; Q], v: &[f64; N]) -> [f64; N];
 
     /// The wall's surface function f(q): motion in f ≥ 0, the wall is f = 0.
     /// Identically zero for an instantaneous model.

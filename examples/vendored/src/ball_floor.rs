@@ -11,6 +11,8 @@
 //   kinetic_energy               5 add, 9 mul, 0 div, 0 fn (14 in all)
 //   potential                    0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   constraints                  0 add, 0 mul, 0 div, 0 fn (0 in all)
+//   forcing                      0 add, 0 mul, 0 div, 0 fn (0 in all)
+//   constraint_drift             0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_surface                0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_b_rows                 0 add, 1 mul, 0 div, 0 fn (1 in all)
 //   floor_projector              1 add, 10 mul, 1 div, 0 fn (12 in all)
@@ -160,6 +162,24 @@ impl BallFloor {
             ],
             0,
         )
+    }
+    /// h(q, q̇): the equations of motion are G(q) q̈ + h(q, q̇) = A(q)ᵀλ (zero for an instantaneous model).
+    #[inline]
+    #[allow(unused_variables)]
+    pub fn forcing(&self, q: &[f64; 0], v: &[f64; 6]) -> [f64; 6] {
+        let o0: f64 = 0f64;
+        let o1: f64 = 0f64;
+        let o2: f64 = 0f64;
+        let o3: f64 = 0f64;
+        let o4: f64 = 0f64;
+        let o5: f64 = 0f64;
+        [o0, o1, o2, o3, o4, o5]
+    }
+    /// Ȧq̇, one entry per row of A (the rest zero): A q̈ + Ȧq̇ = 0 along the motion.
+    #[inline]
+    #[allow(unused_variables)]
+    pub fn constraint_drift(&self, q: &[f64; 0], v: &[f64; 6]) -> [f64; 6] {
+        [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
     }
     /// Wall `floor`: the surface function f(q).
     #[inline]
@@ -359,6 +379,12 @@ impl ::dalembert_runtime::Model<0, 6> for BallFloor {
     }
     fn constraints(&self, q: &[f64; 0]) -> ::dalembert_runtime::Rows<6> {
         self.constraints(q)
+    }
+    fn forcing(&self, q: &[f64; 0], v: &[f64; 6]) -> [f64; 6] {
+        self.forcing(q, v)
+    }
+    fn constraint_drift(&self, q: &[f64; 0], v: &[f64; 6]) -> [f64; 6] {
+        self.constraint_drift(q, v)
     }
     fn surface(&self, wall: Wall, q: &[f64; 0]) -> f64 {
         match wall {
