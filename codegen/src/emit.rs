@@ -140,7 +140,6 @@ fn inherent_impl(d: &Derivation) -> TokenStream {
         "The mass matrix G(q).",
         &d.programs.mass_matrix,
         n,
-        false,
     );
     let kinetic = fn_scalar(
         d,
@@ -169,7 +168,7 @@ fn inherent_impl(d: &Derivation) -> TokenStream {
         "h(q, q̇): the equations of motion are G(q) q̈ + h(q, q̇) = A(q)ᵀλ (zero for an instantaneous model).",
         &d.programs.forcing,
     );
-    let drift = fn_padded(
+    let drift = fn_vector(
         d,
         "constraint_drift",
         "Ȧq̇, one entry per row of A (the rest zero): A q̈ + Ȧq̇ = 0 along the motion.",
@@ -222,7 +221,6 @@ fn wall_fns(d: &Derivation, w: &WallDerivation) -> TokenStream {
         &format!("Wall `{name}`: the projector P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B."),
         &w.programs.projector,
         n,
-        false,
     );
     let collide = fn_vector(
         d,
@@ -245,7 +243,17 @@ fn args(d: &Derivation, with_v: bool) -> TokenStream {
     }
 }
 
-fn fn_scalar(d: &Derivation, name: &str, doc: &str, p: &Program, with_v: bool) -> TokenStream {
+/// An emitted method: doc, `#[inline]`, the arguments, the program's
+/// statements, then `result` of type `ret`.
+fn function(
+    d: &Derivation,
+    name: &str,
+    doc: &str,
+    p: &Program,
+    with_v: bool,
+    ret: TokenStream,
+    result: TokenStream,
+) -> TokenStream {
     let f = ident(name);
     let args = args(d, with_v);
     let body = body(d, p);
@@ -254,31 +262,18 @@ fn fn_scalar(d: &Derivation, name: &str, doc: &str, p: &Program, with_v: bool) -
         #doc
         #[inline]
         #[allow(unused_variables)]
-        pub fn #f(&self, #args) -> f64 { #body o0 }
+        pub fn #f(&self, #args) -> #ret { #body #result }
     }
 }
 
+fn fn_scalar(d: &Derivation, name: &str, doc: &str, p: &Program, with_v: bool) -> TokenStream {
+    function(d, name, doc, p, with_v, quote! { f64 }, quote! { o0 })
+}
+
+/// A function of (q, v) returning an n-vector: the program's outputs, padded
+/// with zeros when it has fewer than n.
 fn fn_vector(d: &Derivation, name: &str, doc: &str, p: &Program) -> TokenStream {
-    let f = ident(name);
-    let args = args(d, true);
-    let body = body(d, p);
-    let outs = (0..p.outputs).map(|i| format_ident!("o{i}"));
-    let n = Literal::usize_unsuffixed(p.outputs);
-    let doc = doc_attr(doc);
-    quote! {
-        #doc
-        #[inline]
-        #[allow(unused_variables)]
-        pub fn #f(&self, #args) -> [f64; #n] { #body [#(#outs),*] }
-    }
-}
-
-/// A function of (q, v) returning its k outputs padded with zeros to length n.
-fn fn_padded(d: &Derivation, name: &str, doc: &str, p: &Program) -> TokenStream {
     let n = d.model.velocities.len();
-    let f = ident(name);
-    let args = args(d, true);
-    let body = body(d, p);
     let outs = (0..n).map(|i| {
         if i < p.outputs {
             let o = format_ident!("o{i}");
@@ -288,47 +283,38 @@ fn fn_padded(d: &Derivation, name: &str, doc: &str, p: &Program) -> TokenStream 
         }
     });
     let nl = Literal::usize_unsuffixed(n);
-    let doc = doc_attr(doc);
-    quote! {
-        #doc
-        #[inline]
-        #[allow(unused_variables)]
-        pub fn #f(&self, #args) -> [f64; #nl] { #body [#(#outs),*] }
-    }
+    function(
+        d,
+        name,
+        doc,
+        p,
+        true,
+        quote! { [f64; #nl] },
+        quote! { [#(#outs),*] },
+    )
 }
 
 /// A function returning an n×n matrix from a program with n² outputs.
-fn fn_matrix(
-    d: &Derivation,
-    name: &str,
-    doc: &str,
-    p: &Program,
-    n: usize,
-    with_v: bool,
-) -> TokenStream {
-    let f = ident(name);
-    let args = args(d, with_v);
-    let body = body(d, p);
+fn fn_matrix(d: &Derivation, name: &str, doc: &str, p: &Program, n: usize) -> TokenStream {
     let rows = (0..n).map(|i| {
         let cols = (0..n).map(move |j| format_ident!("o{}", i * n + j));
         quote! { [#(#cols),*] }
     });
     let nl = Literal::usize_unsuffixed(n);
-    let doc = doc_attr(doc);
-    quote! {
-        #doc
-        #[inline]
-        #[allow(unused_variables)]
-        pub fn #f(&self, #args) -> [[f64; #nl]; #nl] { #body [#(#rows),*] }
-    }
+    function(
+        d,
+        name,
+        doc,
+        p,
+        false,
+        quote! { [[f64; #nl]; #nl] },
+        quote! { [#(#rows),*] },
+    )
 }
 
 /// A function returning `k` rows of length n (padded to n rows) as `Rows`.
 fn fn_rows(d: &Derivation, name: &str, doc: &str, p: &Program, k: usize) -> TokenStream {
     let n = d.model.velocities.len();
-    let f = ident(name);
-    let args = args(d, false);
-    let body = body(d, p);
     let rows = (0..n).map(|i| {
         if i < k {
             let cols = (0..n).map(move |j| format_ident!("o{}", i * n + j));
@@ -339,16 +325,15 @@ fn fn_rows(d: &Derivation, name: &str, doc: &str, p: &Program, k: usize) -> Toke
     });
     let nl = Literal::usize_unsuffixed(n);
     let kl = Literal::usize_unsuffixed(k);
-    let doc = doc_attr(doc);
-    quote! {
-        #doc
-        #[inline]
-        #[allow(unused_variables)]
-        pub fn #f(&self, #args) -> ::dalembert_runtime::Rows<#nl> {
-            #body
-            ::dalembert_runtime::Rows::new([#(#rows),*], #kl)
-        }
-    }
+    function(
+        d,
+        name,
+        doc,
+        p,
+        false,
+        quote! { ::dalembert_runtime::Rows<#nl> },
+        quote! { ::dalembert_runtime::Rows::new([#(#rows),*], #kl) },
+    )
 }
 
 /// Statements computing `o0, o1, …` from the program.
