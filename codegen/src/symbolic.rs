@@ -856,10 +856,9 @@ impl<'a> Deriver<'a> {
     /// v⁺ component printed as a combination of the velocities.
     fn collect_velocities(&self, c: &Atom) -> String {
         let mut terms = Vec::new();
+        let vars = self.var_map();
         for (k, v) in self.vels.iter().enumerate() {
-            let coeff = c.derivative(*v);
-            let vars = self.var_map();
-            let coeff = self.reduce_atom(&coeff, &vars);
+            let coeff = self.reduce_atom(&c.derivative(*v), &vars);
             if is_zero(&coeff) {
                 continue;
             }
