@@ -267,7 +267,16 @@ impl<'a> Deriver<'a> {
             .map(|r| r.iter().map(|a| to_rat(self, a)).collect())
             .collect();
 
-        self.check_positive_definite(&g);
+        let g_simpl: Vec<Vec<Atom>> = g
+            .iter()
+            .map(|r| r.iter().map(|a| self.reduce_atom(a, &vars)).collect())
+            .collect();
+        let inputs = self.inputs();
+        let mass_matrix = self.program(
+            &g_simpl.iter().flatten().cloned().collect::<Vec<_>>(),
+            &inputs,
+        )?;
+        self.check_positive_definite(&mass_matrix, n);
         let g_inv = match g_mat.inv() {
             Ok(i) => i,
             Err(_) => {
@@ -281,7 +290,6 @@ impl<'a> Deriver<'a> {
             }
         };
 
-        let inputs = self.inputs();
         let mut walls = Vec::new();
         for (w, (surface, normal, contact)) in m.walls.iter().zip(walls_raw) {
             let normal_r: Vec<Rat> = normal.iter().map(|a| to_rat(self, a)).collect();
@@ -355,18 +363,11 @@ impl<'a> Deriver<'a> {
             });
         }
 
-        let g_simpl: Vec<Vec<Atom>> = g
-            .iter()
-            .map(|r| r.iter().map(|a| self.reduce_atom(a, &vars)).collect())
-            .collect();
         let (forcing, drift) = self.equations_of_motion(&t, &v_atom, &a_rows);
         let programs = Programs {
             forcing: self.program(&forcing, &inputs)?,
             constraint_drift: self.program(&drift, &inputs)?,
-            mass_matrix: self.program(
-                &g_simpl.iter().flatten().cloned().collect::<Vec<_>>(),
-                &inputs,
-            )?,
+            mass_matrix,
             kinetic_energy: self.program(std::slice::from_ref(&t), &inputs)?,
             potential: self.program(std::slice::from_ref(&v_atom), &inputs)?,
             constraints: self.program(
@@ -519,13 +520,7 @@ impl<'a> Deriver<'a> {
 
     /// G positive definite at the sample point (file's parameter values,
     /// [`sample_configuration`]): a Cholesky factorisation must succeed.
-    fn check_positive_definite(&mut self, g: &[Vec<Atom>]) {
-        let n = g.len();
-        let inputs = self.inputs();
-        let Some(prog) = self.program(&g.iter().flatten().cloned().collect::<Vec<_>>(), &inputs)
-        else {
-            return;
-        };
+    fn check_positive_definite(&mut self, prog: &Program, n: usize) {
         let values = self.sample_inputs();
         let vals = prog.eval(&values);
         let gm = nalgebra::DMatrix::from_row_slice(n, n, &vals);
