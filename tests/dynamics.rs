@@ -8,7 +8,9 @@
 use dalembert::models::{BallWallEuler, Puck};
 use dalembert::runtime::Model;
 use dalembert::runtime::dynamics::{DynamicsError, accelerations};
-use nalgebra::DMatrix;
+
+mod common;
+use common::onto_kernel;
 
 fn lcg(state: &mut u64) -> f64 {
     *state = state
@@ -19,16 +21,7 @@ fn lcg(state: &mut u64) -> f64 {
 
 /// v projected onto ker A(q).
 fn admissible<M: Model<N, N>, const N: usize>(m: &M, q: &[f64; N], v: [f64; N]) -> [f64; N] {
-    let a = m.constraints(q);
-    let k = a.len();
-    if k == 0 {
-        return v;
-    }
-    let am = DMatrix::from_fn(k, N, |i, j| a.as_slice()[i][j]);
-    let vv = DMatrix::from_fn(N, 1, |i, _| v[i]);
-    let lam = (&am * am.transpose()).lu().solve(&(&am * &vv)).unwrap();
-    let w = vv - am.transpose() * lam;
-    std::array::from_fn(|i| w[(i, 0)])
+    onto_kernel(&m.constraints(q), v)
 }
 
 fn step<const N: usize>(x: &[f64; N], dx: &[f64; N], e: f64) -> [f64; N] {

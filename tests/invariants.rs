@@ -10,7 +10,9 @@ use dalembert::for_each_model;
 use dalembert::models::*;
 use dalembert::runtime::linalg::{kinetic_energy, mat_mul, mat_vec, projector};
 use dalembert::runtime::{Model, Rows};
-use nalgebra::DMatrix;
+
+mod common;
+use common::onto_kernel;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 
@@ -23,21 +25,6 @@ fn close(a: f64, b: f64, scale: f64) -> bool {
 
 fn max_abs<const N: usize>(m: &[[f64; N]; N]) -> f64 {
     m.iter().flatten().fold(0.0_f64, |x, y| x.max(y.abs()))
-}
-
-/// Projects v onto ker A (Euclidean; membership in ker A does not depend on
-/// the metric).
-fn onto_kernel<const N: usize>(a: &Rows<N>, v: [f64; N]) -> [f64; N] {
-    let k = a.len();
-    if k == 0 {
-        return v;
-    }
-    let am = DMatrix::from_fn(k, N, |i, j| a.as_slice()[i][j]);
-    let vv = DMatrix::from_fn(N, 1, |i, _| v[i]);
-    let aat = &am * am.transpose();
-    let lam = aat.lu().solve(&(&am * &vv)).expect("A has full row rank");
-    let w = vv - am.transpose() * lam;
-    std::array::from_fn(|i| w[(i, 0)])
 }
 
 /// Checks every invariant for one model instance at (q, v).
