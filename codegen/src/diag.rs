@@ -71,6 +71,11 @@ pub enum ErrorKind {
     /// The potential depends on velocities.
     #[error("the potential depends on the velocity `{0}`")]
     VelocityInPotential(String),
+    /// A holonomic constraint h(q) = 0 depends on a velocity.
+    #[error(
+        "a holonomic constraint depends on the velocity `{0}`: declare velocity-level constraints under `constraints`"
+    )]
+    VelocityInHolonomic(String),
     /// A surface function depends on velocities.
     #[error("wall `{wall}`: the surface function depends on the velocity `{velocity}`")]
     VelocityInSurface {

@@ -162,6 +162,12 @@ fn inherent_impl(d: &Derivation) -> TokenStream {
         &d.programs.constraints,
         d.constraint_rows.len(),
     );
+    let holonomic = fn_values(
+        d,
+        "holonomic",
+        "The holonomic constraints h(q) (zero on the constraint manifold); their differentials are the first rows of A.",
+        &d.programs.holonomic,
+    );
     let forcing = fn_vector(
         d,
         "forcing",
@@ -191,6 +197,7 @@ fn inherent_impl(d: &Derivation) -> TokenStream {
             #kinetic
             #potential
             #constraints
+            #holonomic
             #forcing
             #drift
             #( #walls )*
@@ -274,14 +281,7 @@ fn fn_scalar(d: &Derivation, name: &str, doc: &str, p: &Program, with_v: bool) -
 /// with zeros when it has fewer than n.
 fn fn_vector(d: &Derivation, name: &str, doc: &str, p: &Program) -> TokenStream {
     let n = d.model.velocities.len();
-    let outs = (0..n).map(|i| {
-        if i < p.outputs {
-            let o = format_ident!("o{i}");
-            quote! { #o }
-        } else {
-            quote! { 0.0 }
-        }
-    });
+    let outs = padded_outputs(p, n);
     let nl = Literal::usize_unsuffixed(n);
     function(
         d,
@@ -291,6 +291,35 @@ fn fn_vector(d: &Derivation, name: &str, doc: &str, p: &Program) -> TokenStream 
         true,
         quote! { [f64; #nl] },
         quote! { [#(#outs),*] },
+    )
+}
+
+/// `o0, o1, …` for the program's outputs, then `0.0` up to n entries.
+fn padded_outputs(p: &Program, n: usize) -> impl Iterator<Item = TokenStream> + '_ {
+    (0..n).map(move |i| {
+        if i < p.outputs {
+            let o = format_ident!("o{i}");
+            quote! { #o }
+        } else {
+            quote! { 0.0 }
+        }
+    })
+}
+
+/// A function of q returning the program's k ≤ n outputs as `Rows1`.
+fn fn_values(d: &Derivation, name: &str, doc: &str, p: &Program) -> TokenStream {
+    let n = d.model.velocities.len();
+    let outs = padded_outputs(p, n);
+    let nl = Literal::usize_unsuffixed(n);
+    let kl = Literal::usize_unsuffixed(p.outputs);
+    function(
+        d,
+        name,
+        doc,
+        p,
+        false,
+        quote! { ::dalembert_runtime::Rows1<#nl> },
+        quote! { ::dalembert_runtime::Rows1::new([#(#outs),*], #kl) },
     )
 }
 
@@ -510,6 +539,7 @@ fn trait_impl(d: &Derivation) -> TokenStream {
             fn kinetic_energy(&self, q: &[f64; #ql], v: &[f64; #nl]) -> f64 { self.kinetic_energy(q, v) }
             fn potential(&self, q: &[f64; #ql]) -> f64 { self.potential(q) }
             fn constraints(&self, q: &[f64; #ql]) -> ::dalembert_runtime::Rows<#nl> { self.constraints(q) }
+            fn holonomic(&self, q: &[f64; #ql]) -> ::dalembert_runtime::Rows1<#nl> { self.holonomic(q) }
             fn forcing(&self, q: &[f64; #ql], v: &[f64; #nl]) -> [f64; #nl] { self.forcing(q, v) }
             fn constraint_drift(&self, q: &[f64; #ql], v: &[f64; #nl]) -> [f64; #nl] { self.constraint_drift(q, v) }
             fn surface(&self, wall: Wall, q: &[f64; #ql]) -> f64 { #surface }
@@ -576,6 +606,7 @@ pub fn op_counts(d: &Derivation) -> Vec<(String, OpCount)> {
         ),
         ("potential".to_string(), d.programs.potential.op_count()),
         ("constraints".to_string(), d.programs.constraints.op_count()),
+        ("holonomic".to_string(), d.programs.holonomic.op_count()),
         ("forcing".to_string(), d.programs.forcing.op_count()),
         (
             "constraint_drift".to_string(),

@@ -92,6 +92,8 @@ struct Dynamics {
     kinetic_energy: Spanned<String>,
     potential: Option<Spanned<String>>,
     #[serde(default)]
+    holonomic: Vec<Spanned<String>>,
+    #[serde(default)]
     constraints: Vec<Spanned<String>>,
 }
 
@@ -202,6 +204,8 @@ pub struct Model {
     pub kinetic_energy: Expr,
     /// V (None: zero).
     pub potential: Option<Expr>,
+    /// Holonomic constraints h(q) = 0 (coordinate models only).
+    pub holonomic: Vec<Expr>,
     /// Rows of A, each = 0.
     pub constraints: Vec<Expr>,
     /// Walls in file order.
@@ -302,6 +306,18 @@ impl Validator<'_> {
         let dynamics = file.dynamics.into_inner();
         let kinetic_energy = self.expr(&dynamics.kinetic_energy);
         let potential = dynamics.potential.as_ref().map(|p| self.expr(p));
+        let holonomic = dynamics.holonomic.iter().map(|c| self.expr(c)).collect();
+        if kind == Kind::Instantaneous
+            && let Some(h) = dynamics.holonomic.first()
+        {
+            self.cx.error(
+                ErrorKind::Structure(
+                    "holonomic constraints h(q) = 0 need coordinates; an instantaneous model has none"
+                        .into(),
+                ),
+                Some(h.span()),
+            );
+        }
         let constraints = dynamics.constraints.iter().map(|c| self.expr(c)).collect();
 
         let walls = self.walls(kind, &file.wall);
@@ -321,6 +337,7 @@ impl Validator<'_> {
             definitions,
             kinetic_energy,
             potential,
+            holonomic,
             constraints,
             walls,
             source: self.text.to_string(),
@@ -709,6 +726,7 @@ impl Model {
             .map(|(_, e)| e)
             .chain(std::iter::once(&self.kinetic_energy))
             .chain(self.potential.iter())
+            .chain(self.holonomic.iter())
             .chain(self.constraints.iter())
             .chain(self.walls.iter().flat_map(|w| {
                 w.surface

@@ -34,8 +34,10 @@ pub struct Derivation {
     pub model: Model,
     /// G, entry by entry.
     pub mass_matrix: Vec<Vec<String>>,
-    /// Rows of A.
+    /// Rows of A: the differentials of the holonomic constraints first.
     pub constraint_rows: Vec<Vec<String>>,
+    /// The holonomic constraints h(q).
+    pub holonomic: Vec<String>,
     /// Per wall.
     pub walls: Vec<WallDerivation>,
     /// Programs for the model-wide functions.
@@ -53,6 +55,8 @@ pub struct Programs {
     pub potential: Program,
     /// A (k·n outputs, row-major).
     pub constraints: Program,
+    /// h(q), one output per holonomic constraint.
+    pub holonomic: Program,
     /// h(q, q̇) of G q̈ + h = Aᵀλ (n outputs; zero for instantaneous models).
     pub forcing: Program,
     /// Ȧq̇, one output per row of A (zero for instantaneous models).
@@ -210,9 +214,25 @@ impl<'a> Deriver<'a> {
         }
         self.check_quadratic(&t, &g);
 
-        // A: one row per constraint.
+        // A: dh for every holonomic constraint, then one row per
+        // velocity-level constraint.
         let mut a_rows = Vec::new();
-        for c in &m.constraints {
+        let mut a_labels = Vec::new();
+        let mut holonomic = Vec::new();
+        for (k, c) in m.holonomic.iter().enumerate() {
+            let h = self.parse(c)?;
+            self.no_velocity(&h, &c.span, ErrorKind::VelocityInHolonomic);
+            a_rows.push(
+                self.coords
+                    .iter()
+                    .map(|q| h.derivative(*q).expand())
+                    .collect::<Vec<_>>(),
+            );
+            a_labels.push(format!("holonomic constraint {}", k + 1));
+            holonomic.push(h);
+        }
+        for (k, c) in m.constraints.iter().enumerate() {
+            a_labels.push(format!("constraint {}", k + 1));
             let e = self.parse(c)?;
             a_rows.push(self.linear_row(&e, &c.span)?);
         }
@@ -298,8 +318,8 @@ impl<'a> Deriver<'a> {
                 .map(|r| r.iter().map(|a| to_rat(self, a)).collect())
                 .collect();
             let mut candidates = vec![(normal_r, "the normal velocity".to_string())];
-            for (k, r) in a_rat.iter().enumerate() {
-                candidates.push((r.clone(), format!("constraint {}", k + 1)));
+            for (r, label) in a_rat.iter().zip(&a_labels) {
+                candidates.push((r.clone(), label.clone()));
             }
             for (k, r) in contact_r.iter().enumerate() {
                 candidates.push((r.clone(), format!("contact constraint {}", k + 1)));
@@ -374,11 +394,13 @@ impl<'a> Deriver<'a> {
                 &a_rows.iter().flatten().cloned().collect::<Vec<_>>(),
                 &inputs,
             )?,
+            holonomic: self.program(&holonomic, &inputs)?,
         };
         Some(Derivation {
             model: m.clone(),
             mass_matrix: strings2(&g_simpl),
             constraint_rows: strings2(&a_rows),
+            holonomic: holonomic.iter().map(|h| h.to_string()).collect(),
             walls,
             programs,
         })

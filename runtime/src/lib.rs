@@ -16,6 +16,7 @@
 
 pub mod dynamics;
 pub mod linalg;
+pub mod simulate;
 
 /// Up to `N` rows of length `N`: a constraint matrix such as A(q) or B(q).
 ///
@@ -75,6 +76,18 @@ pub struct Rows1<const N: usize> {
 }
 
 impl<const N: usize> Rows1<N> {
+    /// No values.
+    pub const EMPTY: Self = Self {
+        values: [0.0; N],
+        len: 0,
+    };
+
+    /// Takes the first `len` values of `values` (at most `N`).
+    pub const fn new(values: [f64; N], len: usize) -> Self {
+        let len = if len > N { N } else { len };
+        Self { values, len }
+    }
+
     /// The values in use.
     pub fn as_slice(&self) -> &[f64] {
         &self.values[..self.len]
@@ -125,8 +138,16 @@ pub trait Model<const Q: usize, const N: usize> {
     fn kinetic_energy(&self, q: &[f64; Q], v: &[f64; N]) -> f64;
     /// Potential energy V(q).
     fn potential(&self, q: &[f64; Q]) -> f64;
-    /// Rows of the nonholonomic constraints A(q): admissible v have A v = 0.
+    /// Rows of the constraints A(q): admissible v have A v = 0. The first
+    /// [`Model::holonomic`]`(q).len()` rows are the differentials dh(q) of the
+    /// holonomic constraints, the rest are the nonholonomic ones.
     fn constraints(&self, q: &[f64; Q]) -> Rows<N>;
+    /// The holonomic constraints' values h(q) (zero on the constraint
+    /// manifold). None unless the model file declares `holonomic`.
+    fn holonomic(&self, q: &[f64; Q]) -> Rows1<N> {
+        let _ = q;
+        Rows1::EMPTY
+    }
     /// h(q, q̇) in the Lagrange–d'Alembert equations G(q) q̈ + h(q, q̇) = A(q)ᵀλ
     /// (zero for an instantaneous model). See [`dynamics::accelerations`].
     fn forcing(&self, q: &[f64; Q], v: &[f64; N]) -> [f64; N];

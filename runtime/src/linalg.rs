@@ -43,6 +43,8 @@ pub enum ProjectorError {
     MassMatrixNotPositiveDefinite,
     /// An input entry is NaN or infinite.
     NonFinite,
+    /// The rows are (numerically) dependent: R G⁻¹ Rᵀ is singular.
+    DependentRows,
 }
 
 /// P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B from G and the rows of B, without allocation.
@@ -75,14 +77,14 @@ pub fn projector<const N: usize>(
             return Err(ProjectorError::MassMatrixNotPositiveDefinite);
         };
         let mut c: [f64; N] = core::array::from_fn(|i| c[i]);
-        let size = dot(&c, &c).sqrt();
+        let size = libm::sqrt(dot(&c, &c));
         for e in &basis[..rank] {
             let k = dot(e, &c);
             for (ci, ei) in c.iter_mut().zip(e) {
                 *ci -= k * ei;
             }
         }
-        let rest = dot(&c, &c).sqrt();
+        let rest = libm::sqrt(dot(&c, &c));
         if size > 0.0 && rest > 1e-12 * size && rank < N {
             basis[rank] = c.map(|x| x / rest);
             rank += 1;
@@ -108,4 +110,52 @@ pub fn projector<const N: usize>(
 pub fn reflect<const N: usize>(p: &[[f64; N]; N], v: &[f64; N]) -> [f64; N] {
     let pv = mat_vec(p, v);
     core::array::from_fn(|i| v[i] - 2.0 * pv[i])
+}
+
+/// The smallest correction in the metric of G that removes the residuals
+/// `r` of the rows `rows`: δ = G⁻¹Rᵀ(RG⁻¹Rᵀ)⁻¹r, so that R δ = r and δ is
+/// G-orthogonal to ker R. Subtracting it from a velocity v with r = R v
+/// projects v onto ker R; subtracting it from q with r = h(q) is one
+/// Gauss–Newton step towards h = 0.
+pub fn correction<const N: usize>(
+    g: &[[f64; N]; N],
+    rows: &[[f64; N]],
+    r: &[f64],
+) -> Result<[f64; N], ProjectorError> {
+    let finite = |x: &[f64]| x.iter().all(|v| v.is_finite());
+    if !g.iter().all(|row| finite(row)) || !rows.iter().all(|row| finite(row)) || !finite(r) {
+        return Err(ProjectorError::NonFinite);
+    }
+    let k = rows.len().min(r.len()).min(N);
+    let chol = SMatrix::<f64, N, N>::from_fn(|i, j| g[i][j])
+        .cholesky()
+        .ok_or(ProjectorError::MassMatrixNotPositiveDefinite)?;
+    // Y's columns G⁻¹Rᵀ; the k×k system R Y μ = r padded to N×N.
+    let mut y = SMatrix::<f64, N, N>::zeros();
+    for (c, row) in rows[..k].iter().enumerate() {
+        y.set_column(
+            c,
+            &chol.solve(&nalgebra::SVector::<f64, N>::from_fn(|i, _| row[i])),
+        );
+    }
+    let mut s = SMatrix::<f64, N, N>::identity();
+    let mut rhs = nalgebra::SVector::<f64, N>::zeros();
+    for (a, row) in rows[..k].iter().enumerate() {
+        let ra = nalgebra::SVector::<f64, N>::from_fn(|i, _| row[i]);
+        for b in 0..k {
+            s[(a, b)] = ra.dot(&y.column(b));
+        }
+        rhs[a] = r[a];
+    }
+    let mu = s
+        .cholesky()
+        .ok_or(ProjectorError::DependentRows)?
+        .solve(&rhs);
+    let delta = y * mu;
+    let out: [f64; N] = core::array::from_fn(|i| delta[i]);
+    if finite(&out) {
+        Ok(out)
+    } else {
+        Err(ProjectorError::DependentRows)
+    }
 }

@@ -11,6 +11,7 @@
 //   kinetic_energy               5 add, 9 mul, 0 div, 0 fn (14 in all)
 //   potential                    0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   constraints                  0 add, 0 mul, 0 div, 0 fn (0 in all)
+//   holonomic                    0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   forcing                      0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   constraint_drift             0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_surface                0 add, 0 mul, 0 div, 0 fn (0 in all)
@@ -162,6 +163,12 @@ impl BallFloor {
             ],
             0,
         )
+    }
+    /// The holonomic constraints h(q) (zero on the constraint manifold); their differentials are the first rows of A.
+    #[inline]
+    #[allow(unused_variables)]
+    pub fn holonomic(&self, q: &[f64; 0]) -> ::dalembert_runtime::Rows1<6> {
+        ::dalembert_runtime::Rows1::new([0.0, 0.0, 0.0, 0.0, 0.0, 0.0], 0)
     }
     /// h(q, q̇): the equations of motion are G(q) q̈ + h(q, q̇) = A(q)ᵀλ (zero for an instantaneous model).
     #[inline]
@@ -379,6 +386,9 @@ impl ::dalembert_runtime::Model<0, 6> for BallFloor {
     }
     fn constraints(&self, q: &[f64; 0]) -> ::dalembert_runtime::Rows<6> {
         self.constraints(q)
+    }
+    fn holonomic(&self, q: &[f64; 0]) -> ::dalembert_runtime::Rows1<6> {
+        self.holonomic(q)
     }
     fn forcing(&self, q: &[f64; 0], v: &[f64; 6]) -> [f64; 6] {
         self.forcing(q, v)
