@@ -46,6 +46,7 @@ fn exercise<M: Model<Q, N>, const Q: usize, const N: usize>(m: &M) -> f64 {
     let mut s = m.energy(&q, &v) + m.mass_matrix(&q)[0][0];
     s += m.constraints(&q).apply(&v).max_abs();
     s += m.forcing(&q, &v)[0] + m.constraint_drift(&q, &v)[0];
+    s += m.holonomic(&q).max_abs();
     for &w in M::WALLS {
         s += m.surface(w, &q);
         s += m.wall_rows(w, &q).as_slice().len() as f64;
@@ -74,6 +75,44 @@ macro_rules! no_alloc_test {
 }
 
 for_each_model!(no_alloc_test);
+
+/// The simulator, collisions included, with both integrators: the
+/// §3.2.1 ball over some 20 bounces and the Cartesian pendulum (holonomic
+/// projection) against its wall.
+#[test]
+fn simulator_does_not_allocate() {
+    use dalembert::runtime::simulate::{Integrator, Settings, Simulator, State};
+    let ball = BallBounce::default();
+    let r = ball.params.r;
+    let q = [0.0, 0.0, r + 1.0, 0.0, std::f64::consts::FRAC_PI_2, 0.0];
+    let v = [1.0, 0.0, 0.0, 0.0, 0.0, -5.0];
+    let rk4 = Settings {
+        integrator: Integrator::Rk4 { step: 1e-3 },
+        ..Settings::default()
+    };
+    for settings in [Settings::default(), rk4] {
+        let mut collisions = 0;
+        let n = allocations_during(|| {
+            let mut sim = Simulator::new(&ball, State { t: 0.0, q, v }, settings).unwrap();
+            collisions = sim.run(20.0, |_| true).unwrap().collisions;
+        });
+        assert!(collisions >= 20, "{collisions} bounces");
+        assert_eq!(n, 0, "the simulator allocated {n} times");
+        let pendulum = PendulumWall::default();
+        let start = State {
+            t: 0.0,
+            q: [-0.8, -0.6],
+            v: [0.0, 0.0],
+        };
+        let mut hits = 0;
+        let n = allocations_during(|| {
+            let mut sim = Simulator::new(&pendulum, start, settings).unwrap();
+            hits = sim.run(10.0, |_| true).unwrap().collisions;
+        });
+        assert!(hits >= 5, "{hits} hits");
+        assert_eq!(n, 0, "the simulator allocated {n} times");
+    }
+}
 
 /// The counter works: a heap allocation is seen.
 #[test]

@@ -1,0 +1,480 @@
+//! The hybrid simulator on scenarios with analytic answers: the free
+//! pendulum's period (elliptic integral), the pendulum bouncing off a wall,
+//! the paper's §3.2.1 nonholonomic pendulum over more than a thousand
+//! bounces, the rolling ball meeting the wall (Theorem 3.1), two masses in a
+//! box (the textbook law, event by event), and the contacts that must be
+//! reported rather than resolved.
+
+use dalembert::models::{BallBounce, BallWallEuler, MassesOnLine, PendulumWall};
+use dalembert::runtime::Model;
+use dalembert::runtime::dynamics::DynamicsError;
+use dalembert::runtime::simulate::{Integrator, Settings, SimError, Simulator, State, admissible};
+
+// ------------------------------------------------------------ helpers
+
+/// Carlson's symmetric elliptic integral R_F(x, y, z) by duplication.
+fn carlson_rf(mut x: f64, mut y: f64, mut z: f64) -> f64 {
+    for _ in 0..60 {
+        let l = (x * y).sqrt() + (y * z).sqrt() + (z * x).sqrt();
+        x = (x + l) / 4.0;
+        y = (y + l) / 4.0;
+        z = (z + l) / 4.0;
+    }
+    1.0 / ((x + y + z) / 3.0).sqrt()
+}
+
+/// Incomplete elliptic integral of the first kind F(φ, k).
+fn elliptic_f(phi: f64, k: f64) -> f64 {
+    let (s, c) = phi.sin_cos();
+    s * carlson_rf(c * c, 1.0 - k * k * s * s, 1.0)
+}
+
+/// Time for a pendulum of length l released from rest at angle θ₀ (from
+/// the downward vertical) to swing through the bottom to angle θ on the
+/// other side: √(l/g) [K(k) + F(φ, k)], k = sin(θ₀/2), sin φ = sin(θ/2)/k.
+fn pendulum_time(l: f64, g: f64, theta0: f64, theta: f64) -> f64 {
+    let k = (theta0 / 2.0).sin();
+    let phi = ((theta / 2.0).sin() / k).asin();
+    (l / g).sqrt() * (elliptic_f(std::f64::consts::FRAC_PI_2, k) + elliptic_f(phi, k))
+}
+
+fn dormand_prince(rtol: f64) -> Settings {
+    Settings {
+        integrator: Integrator::DormandPrince {
+            rtol,
+            atol: rtol * 1e-2,
+            max_step: f64::INFINITY,
+        },
+        ..Settings::default()
+    }
+}
+
+/// The bob of `PendulumWall` at rest at angle θ₀ on the left.
+fn bob_at_rest(p: &PendulumWall, theta0: f64) -> State<2> {
+    let l = p.params.l;
+    State {
+        t: 0.0,
+        q: [-l * theta0.sin(), -l * theta0.cos()],
+        v: [0.0, 0.0],
+    }
+}
+
+// ------------------------------------------------------------ pendulum
+
+/// With the wall out of reach (d > l) the Cartesian pendulum with its
+/// holonomic rod has the elliptic-integral period, with both integrators,
+/// and the projection keeps it on the circle.
+#[test]
+fn free_pendulum_has_the_elliptic_period() {
+    let mut p = PendulumWall::default();
+    p.params.d = 2.0;
+    let (l, g) = (p.params.l, p.params.g);
+    let theta0 = 1.2;
+    // After one period, 4√(l/g) K(sin(θ₀/2)), the bob is back at rest at
+    // its start.
+    let period = 4.0 * pendulum_time(l, g, theta0, 0.0);
+    for (settings, tol) in [
+        (dormand_prince(1e-12), 1e-9),
+        (
+            Settings {
+                integrator: Integrator::Rk4 { step: 1e-3 },
+                ..Settings::default()
+            },
+            1e-9,
+        ),
+    ] {
+        let start = bob_at_rest(&p, theta0);
+        let mut sim = Simulator::new(&p, start, settings).unwrap();
+        let mut worst = 0.0f64;
+        let e0 = p.energy(&start.q, &start.v);
+        sim.run(period, |s| {
+            worst = worst.max(s.residual.position).max(s.residual.velocity);
+            assert!((s.energy - e0).abs() < 1e-8, "energy {} vs {e0}", s.energy);
+            true
+        })
+        .unwrap();
+        let end = sim.state();
+        assert!(worst < 1e-12, "constraint residual {worst}");
+        let miss = ((end.q[0] - start.q[0]).powi(2) + (end.q[1] - start.q[1]).powi(2)).sqrt();
+        assert!(
+            miss < tol,
+            "{settings:?}: after one period the bob is {miss} from its start"
+        );
+    }
+}
+
+/// Released at θ₀ on the left, the bob meets the wall x = d at the
+/// analytic time, bounces back with its velocity reversed (P = I), returns
+/// to rest at the start at twice that time, and so on.
+#[test]
+fn pendulum_bounces_off_the_wall_as_the_textbook_says() {
+    let p = PendulumWall::default();
+    let (l, g, d) = (p.params.l, p.params.g, p.params.d);
+    let theta0 = 1.0;
+    let theta_w = (d / l).asin();
+    let t_hit = pendulum_time(l, g, theta0, theta_w);
+    let start = bob_at_rest(&p, theta0);
+    let e0 = p.energy(&start.q, &start.v);
+    let mut sim = Simulator::new(&p, start, dormand_prince(1e-12)).unwrap();
+    let mut hits = Vec::new();
+    sim.run(10.5 * t_hit, |s| {
+        if let Some(c) = s.collision {
+            hits.push(c);
+        }
+        true
+    })
+    .unwrap();
+    assert_eq!(hits.len(), 5);
+    for (j, c) in hits.iter().enumerate() {
+        let expected = (2 * j + 1) as f64 * t_hit;
+        assert!(
+            (c.t - expected).abs() < 1e-9,
+            "hit {j} at {} not {expected}",
+            c.t
+        );
+        assert!(c.surface.abs() < 1e-14, "located at f = {}", c.surface);
+        for i in 0..2 {
+            assert!((c.v_plus[i] + c.v_minus[i]).abs() < 1e-12);
+        }
+        assert!((p.energy(&c.q, &c.v_plus) - e0).abs() < 1e-9);
+    }
+}
+
+// ------------------------------------------------------------ §3.2.1
+
+/// The paper's §3.2.1: thrown so that v_S⁻ = −v e_x − u e_z and
+/// ω⁻ = (rmv/J) e_y, the ball comes back along its parabola. It bounces
+/// alternately at x = 0 and x = 2uv/g, every 2u/g, forever.
+///
+/// Tolerance: between bounces the motion is a parabola, which the
+/// fifth-order method reproduces up to rounding, and every bounce is
+/// located by Newton's method to |f| ~ 1e-16. What is left is rounding in
+/// a neutrally stable motion, growing about linearly with the number of
+/// bounces: the collision instants carry ~1e-13 each (the spacing of
+/// doubles near t ≈ 490 is 6e-14). Observed after 1200 bounces: 1.8e-10 in
+/// time, 2.5e-13 in position, 3.7e-13 relative in energy. We ask for 1e-9
+/// in time and position and 1e-10 in energy: a few times the rounding
+/// seen, orders of magnitude below any error of method or of modelling.
+#[test]
+fn nonholonomic_pendulum_is_periodic_over_a_thousand_bounces() {
+    let ball = BallBounce::default();
+    let (m, r, j, g) = (ball.params.m, ball.params.r, ball.params.J, ball.params.g);
+    let (u, v) = (2.0, 1.0);
+    // At φ = ψ = 0, θ = π/2: ω = (θ', −ψ', φ').
+    let q = [0.0, 0.0, r, 0.0, std::f64::consts::FRAC_PI_2, 0.0];
+    let w2 = r * m * v / j;
+    let v_minus = [-v, 0.0, -u, 0.0, 0.0, -w2];
+    let v_plus = ball.collide(dalembert::models::ball_bounce::Wall::Floor, &q, &v_minus);
+    for i in 0..6 {
+        assert!((v_plus[i] + v_minus[i]).abs() < 1e-14, "§3.2.1: v⁺ = −v⁻");
+    }
+    let start = State {
+        t: 0.0,
+        q,
+        v: v_plus,
+    };
+    let e0 = ball.energy(&q, &v_plus);
+    let mut sim = Simulator::new(&ball, start, dormand_prince(1e-10)).unwrap();
+    let flight = 2.0 * u / g;
+    let bounces = 1200;
+    let mut n = 0usize;
+    let mut worst = [0.0f64; 3];
+    sim.run((bounces as f64 + 0.5) * flight, |s| {
+        if let Some(c) = s.collision {
+            n += 1;
+            let x = if n % 2 == 1 { 2.0 * u * v / g } else { 0.0 };
+            worst[0] = worst[0].max((c.t - n as f64 * flight).abs());
+            worst[1] = worst[1].max((c.q[0] - x).abs() + c.q[1].abs() + (c.q[2] - r).abs());
+            worst[2] = worst[2].max((ball.energy(&c.q, &c.v_plus) - e0).abs() / e0);
+            // Each bounce sends the ball back the way it came.
+            for i in 0..3 {
+                assert!((c.v_plus[i] + c.v_minus[i]).abs() < 1e-9);
+            }
+        }
+        true
+    })
+    .unwrap();
+    assert_eq!(n, bounces);
+    eprintln!(
+        "after {n} bounces: |Δt| {:.1e}, |Δq| {:.1e}, |ΔE|/E {:.1e}",
+        worst[0], worst[1], worst[2]
+    );
+    assert!(worst[0] < 1e-9, "time error {}", worst[0]);
+    assert!(worst[1] < 1e-9, "position error {}", worst[1]);
+    assert!(worst[2] < 1e-10, "energy error {}", worst[2]);
+}
+
+// ------------------------------------------------------------ §3.1
+
+/// The angular velocity of `BallWallEuler` in the fixed frame.
+fn omega(q: &[f64; 5], v: &[f64; 5]) -> [f64; 3] {
+    let (phi, theta) = (q[2], q[3]);
+    let (pd, td, sd) = (v[2], v[3], v[4]);
+    [
+        td * phi.cos() + sd * phi.sin() * theta.sin(),
+        td * phi.sin() - sd * phi.cos() * theta.sin(),
+        pd + sd * theta.cos(),
+    ]
+}
+
+/// A spinning ball rolls under the uniform force m·a towards the wall:
+/// its centre moves as x = x₀ + ẋ₀t − ½αt², α = m a r²/J', its spin ω₃ is
+/// constant; it meets the wall x = r at the analytic instant, and the
+/// collision is Theorem 3.1 (at whatever orientation the ball has by then).
+#[test]
+fn rolling_ball_meets_the_wall_as_theorem_3_1_says() {
+    let ball = BallWallEuler::default();
+    let p = ball.params;
+    let (m, r, j, a) = (p.m, p.r, p.J, p.a);
+    let jp = j + r * r * m;
+    let jt = j + r * r * m / 2.0;
+    let alpha = m * a * r * r / jp;
+    let (x0, speed, spin) = (1.5, 0.5, 2.0);
+    // φ = ψ = 0, θ = π/2: ω = (θ', −ψ', φ'), rolling: ẋ = r ω_y.
+    let q = [x0, 0.0, 0.0, std::f64::consts::FRAC_PI_2, 0.0];
+    let v = admissible(&ball, &q, &[-speed, 0.0, spin, 0.0, speed / r]).unwrap();
+    assert!((v[0] + speed).abs() < 1e-15 && (omega(&q, &v)[2] - spin).abs() < 1e-15);
+    let start = State { t: 0.0, q, v };
+    let e0 = ball.energy(&q, &v);
+    let mut sim = Simulator::new(&ball, start, dormand_prince(1e-12)).unwrap();
+    let t_hit = (-speed + (speed * speed + 2.0 * alpha * (x0 - r)).sqrt()) / alpha;
+    let mut hit = None;
+    sim.run(t_hit + 0.2, |s| {
+        assert!(
+            (s.energy - e0).abs() < 1e-9,
+            "energy drift {}",
+            s.energy - e0
+        );
+        assert!(s.residual.velocity < 1e-12);
+        let t = s.state.t;
+        if hit.is_none() && s.collision.is_none() {
+            let x = x0 - speed * t - 0.5 * alpha * t * t;
+            assert!(
+                (s.state.q[0] - x).abs() < 1e-9,
+                "x({t}) = {} not {x}",
+                s.state.q[0]
+            );
+            assert!((omega(&s.state.q, &s.state.v)[2] - spin).abs() < 1e-9);
+        }
+        if let Some(c) = s.collision {
+            hit = Some(c);
+        }
+        true
+    })
+    .unwrap();
+    let c = hit.expect("the ball reaches the wall");
+    assert!((c.t - t_hit).abs() < 1e-9, "hit at {} not {t_hit}", c.t);
+    assert!((c.q[0] - r).abs() < 1e-14);
+    // Theorem 3.1 in the paper's variables (v₁, v₂, ω₃).
+    let (v1, v2, w3) = (c.v_minus[0], c.v_minus[1], omega(&c.q, &c.v_minus)[2]);
+    assert!((v1 + speed + alpha * t_hit).abs() < 1e-9);
+    let expected = [
+        -v1,
+        r * r * m / (2.0 * jt) * v2 + r * j / jt * w3,
+        jp / (r * jt) * v2 - r * r * m / (2.0 * jt) * w3,
+    ];
+    let got = [c.v_plus[0], c.v_plus[1], omega(&c.q, &c.v_plus)[2]];
+    for i in 0..3 {
+        assert!(
+            (got[i] - expected[i]).abs() < 1e-12,
+            "Theorem 3.1, component {i}: {got:?} vs {expected:?}"
+        );
+    }
+    // And it keeps rolling with the new spin.
+    assert!((omega(&sim.state().q, &sim.state().v)[2] - expected[2]).abs() < 1e-9);
+}
+
+// ------------------------------------------------------------ textbook
+
+/// Two masses in a box, followed collision by collision: every event is
+/// the one free flight predicts (which wall, when), and every impact of
+/// the two bodies is the textbook law.
+#[test]
+fn two_masses_in_a_box_follow_the_textbook_event_by_event() {
+    use dalembert::models::masses_on_line::Wall;
+    let sys = MassesOnLine::default();
+    let (m1, m2, len) = (sys.params.m1, sys.params.m2, sys.params.L);
+    let start = State {
+        t: 0.0,
+        q: [0.2, 0.6],
+        v: [1.0, -0.5],
+    };
+    let e0 = sys.energy(&start.q, &start.v);
+    let mut sim = Simulator::new(&sys, start, dormand_prince(1e-10)).unwrap();
+    let mut prev = start;
+    let mut events = 0;
+    sim.run(40.0, |s| {
+        let Some(c) = s.collision else { return true };
+        events += 1;
+        // Free flight from the previous event: the first wall reached.
+        let (x, u) = (prev.q, prev.v);
+        let candidates = [
+            (
+                Wall::Left,
+                if u[0] < 0.0 {
+                    -x[0] / u[0]
+                } else {
+                    f64::INFINITY
+                },
+            ),
+            (
+                Wall::Contact,
+                if u[1] - u[0] < 0.0 {
+                    (x[1] - x[0]) / (u[0] - u[1])
+                } else {
+                    f64::INFINITY
+                },
+            ),
+            (
+                Wall::Right,
+                if u[1] > 0.0 {
+                    (len - x[1]) / u[1]
+                } else {
+                    f64::INFINITY
+                },
+            ),
+        ];
+        let (wall, dt) =
+            candidates.into_iter().fold(
+                (Wall::Left, f64::INFINITY),
+                |b, c| if c.1 < b.1 { c } else { b },
+            );
+        assert_eq!(c.wall, wall, "event {events}");
+        assert!(
+            (c.t - (prev.t + dt)).abs() < 1e-12 * (1.0 + c.t),
+            "event {events}: {} vs {}",
+            c.t,
+            prev.t + dt
+        );
+        let [u1, u2] = c.v_minus;
+        let expected = match wall {
+            Wall::Left => [-u1, u2],
+            Wall::Right => [u1, -u2],
+            Wall::Contact => [
+                ((m1 - m2) * u1 + 2.0 * m2 * u2) / (m1 + m2),
+                ((m2 - m1) * u2 + 2.0 * m1 * u1) / (m1 + m2),
+            ],
+        };
+        for (got, want) in c.v_plus.iter().zip(expected) {
+            assert!((got - want).abs() < 1e-13);
+        }
+        assert!((sys.energy(&c.q, &c.v_plus) - e0).abs() < 1e-12);
+        prev = State {
+            t: c.t,
+            q: c.q,
+            v: c.v_plus,
+        };
+        true
+    })
+    .unwrap();
+    assert!(events > 50, "only {events} events");
+}
+
+// ------------------------------------------------------------ reported, not resolved
+
+#[test]
+fn simultaneous_contacts_are_reported() {
+    use dalembert::models::masses_on_line::Wall;
+    let sys = MassesOnLine::default();
+    // x1 meets the left wall when x2 meets the right one.
+    let start = State {
+        t: 0.0,
+        q: [0.25, 0.75],
+        v: [-1.0, 1.0],
+    };
+    let mut sim = Simulator::new(&sys, start, Settings::default()).unwrap();
+    match sim.run(1.0, |_| true) {
+        Err(SimError::Simultaneous { first, second, t }) => {
+            assert!((t - 0.25).abs() < 1e-12);
+            let mut pair = [first, second];
+            pair.sort_by_key(|w| *w as u8);
+            assert_eq!(pair, [Wall::Left, Wall::Right]);
+        }
+        other => panic!("expected a simultaneous contact, got {other:?}"),
+    }
+}
+
+#[test]
+fn grazing_contacts_are_reported() {
+    let ball = BallBounce::default();
+    let r = ball.params.r;
+    // 1e-15 above the floor, fast along it: the floor is met at a normal
+    // speed √(2g·1e-15) ≈ 1.4e-7, about 1e-9 of the speed.
+    let q = [0.0, 0.0, r + 1e-15, 0.0, std::f64::consts::FRAC_PI_2, 0.0];
+    let start = State {
+        t: 0.0,
+        q,
+        v: [100.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    };
+    let mut sim = Simulator::new(&ball, start, Settings::default()).unwrap();
+    match sim.run(1.0, |_| true) {
+        Err(SimError::Grazing {
+            t, normal_velocity, ..
+        }) => {
+            assert!(t < 1e-6 && normal_velocity < 0.0 && normal_velocity > -1e-6);
+        }
+        other => panic!("expected a grazing contact, got {other:?}"),
+    }
+}
+
+#[test]
+fn bad_states_are_typed_errors() {
+    let ball = BallBounce::default();
+    let r = ball.params.r;
+    let fly = |q: [f64; 6], v: [f64; 6]| {
+        Simulator::new(&ball, State { t: 0.0, q, v }, Settings::default())
+            .and_then(|mut s| s.run(2.0, |_| true))
+    };
+    // Non-finite.
+    let q = [0.0, 0.0, 1.0, 0.0, 1.0, 0.0];
+    assert!(matches!(
+        fly([f64::NAN; 6], [0.0; 6]),
+        Err(SimError::Inadmissible { .. })
+    ));
+    // Below the floor.
+    let below = [0.0, 0.0, r - 0.1, 0.0, 1.0, 0.0];
+    assert!(matches!(
+        fly(below, [0.0; 6]),
+        Err(SimError::StartsBeyondWall { .. })
+    ));
+    // At the Euler angles' singularity θ = 0, G is singular: a typed
+    // error from the start, never NaN.
+    let singular = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0];
+    assert!(matches!(
+        fly(singular, [0.0; 6]),
+        Err(SimError::Dynamics {
+            error: DynamicsError::SingularMassMatrix,
+            ..
+        })
+    ));
+    // Inadmissible: the rolling ball's velocity off ker A.
+    let rolling = BallWallEuler::default();
+    let q5 = [1.0, 0.0, 0.0, 1.0, 0.0];
+    let bad = Simulator::new(
+        &rolling,
+        State {
+            t: 0.0,
+            q: q5,
+            v: [1.0, 0.0, 0.0, 0.0, 0.0],
+        },
+        Settings::default(),
+    );
+    assert!(matches!(bad, Err(SimError::Inadmissible { .. })));
+    // A bad setting.
+    let rk0 = Settings {
+        integrator: Integrator::Rk4 { step: 0.0 },
+        ..Settings::default()
+    };
+    assert!(matches!(
+        Simulator::new(
+            &ball,
+            State {
+                t: 0.0,
+                q,
+                v: [0.0; 6]
+            },
+            rk0
+        ),
+        Err(SimError::BadSettings)
+    ));
+}
