@@ -3,7 +3,10 @@
 //! `paper` derives the paper's models and compares them with what the paper
 //! prints; `derive` shows what the generator derives for any model file;
 //! `generate` writes its Rust code (to vendor it without symbolica);
-//! `check` compares a derivation with a reference file.
+//! `check` compares a derivation with a reference file; `simulate` runs a
+//! built-in model through collisions and writes its trajectory and a plot.
+
+mod sim;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -62,6 +65,9 @@ enum Command {
         /// The reference file.
         reference: PathBuf,
     },
+    /// Simulate a built-in model through its collisions; write the
+    /// trajectory (CSV) and a plot (SVG).
+    Simulate(sim::SimulateArgs),
 }
 
 fn main() -> ExitCode {
@@ -72,6 +78,7 @@ fn main() -> ExitCode {
         Command::Derive { file, latex: true } => derive(&file).and_then(|d| print_latex(&d)),
         Command::Generate { file, output } => generate(&file, output.as_deref()),
         Command::Check { file, reference } => check(&file, &reference),
+        Command::Simulate(args) => sim::simulate(&args),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,

@@ -183,12 +183,24 @@ fn inherent_impl(d: &Derivation) -> TokenStream {
     let walls = d.walls.iter().map(|w| wall_fns(d, w));
     let qn = Literal::usize_unsuffixed(q);
     let nn = Literal::usize_unsuffixed(n);
+    let init_q = d.model.initial[..q]
+        .iter()
+        .map(|x| Literal::f64_suffixed(*x));
+    let init_v = d.model.initial[q..]
+        .iter()
+        .map(|x| Literal::f64_suffixed(*x));
     quote! {
         impl #ty {
             /// Number of coordinates.
             pub const Q: usize = #qn;
             /// Number of velocity components.
             pub const N: usize = #nn;
+            /// The model file's initial coordinates (`[initial]`, zero where silent).
+            #[allow(clippy::approx_constant)]
+            pub const INITIAL_COORDINATES: [f64; #qn] = [#(#init_q),*];
+            /// The model file's initial velocities (`[initial]`, zero where silent).
+            #[allow(clippy::approx_constant)]
+            pub const INITIAL_VELOCITIES: [f64; #nn] = [#(#init_v),*];
             /// The model with the given parameters.
             pub const fn new(params: Params) -> Self {
                 Self { params }
@@ -524,6 +536,8 @@ fn trait_impl(d: &Derivation) -> TokenStream {
             const COORDINATES: &'static [&'static str] = &[#(#coords),*];
             const VELOCITIES: &'static [&'static str] = &[#(#vels),*];
             const PARAMETERS: &'static [&'static str] = &[#(#pnames),*];
+            const INITIAL_COORDINATES: [f64; #ql] = Self::INITIAL_COORDINATES;
+            const INITIAL_VELOCITIES: [f64; #nl] = Self::INITIAL_VELOCITIES;
             fn with_params(params: Params) -> Self { Self { params } }
             fn params(&self) -> &Params { &self.params }
             fn parameter(&self, index: usize) -> Option<f64> {

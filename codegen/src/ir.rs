@@ -49,6 +49,8 @@ struct File {
     dynamics: Spanned<Dynamics>,
     #[serde(default)]
     wall: Vec<Spanned<WallDecl>>,
+    #[serde(default)]
+    initial: IndexMap<Spanned<String>, Spanned<Number>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -210,6 +212,9 @@ pub struct Model {
     pub constraints: Vec<Expr>,
     /// Walls in file order.
     pub walls: Vec<Wall>,
+    /// The initial state for simulations: one value per coordinate, then
+    /// one per velocity (zero where the file's `[initial]` is silent).
+    pub initial: Vec<f64>,
     /// The model file's text.
     pub source: String,
     /// The model file.
@@ -321,6 +326,7 @@ impl Validator<'_> {
         let constraints = dynamics.constraints.iter().map(|c| self.expr(c)).collect();
 
         let walls = self.walls(kind, &file.wall);
+        let initial = self.initial(&coordinates, &velocities, &file.initial);
         if file.wall.is_empty() {
             self.cx.error(
                 ErrorKind::Structure("the model has no wall: declare at least one [[wall]]".into()),
@@ -340,6 +346,7 @@ impl Validator<'_> {
             holonomic,
             constraints,
             walls,
+            initial,
             source: self.text.to_string(),
             file: path.to_path_buf(),
         })
@@ -589,6 +596,37 @@ impl Validator<'_> {
         out
     }
 
+    /// The `[initial]` table: values for coordinates and velocities, exact
+    /// numbers or rational multiples of `pi`.
+    fn initial(
+        &mut self,
+        coordinates: &[String],
+        velocities: &[String],
+        decls: &IndexMap<Spanned<String>, Spanned<Number>>,
+    ) -> Vec<f64> {
+        let mut out = vec![0.0; coordinates.len() + velocities.len()];
+        for (name, value) in decls {
+            let n = name.get_ref();
+            let Some(slot) = coordinates.iter().chain(velocities).position(|c| c == n) else {
+                self.cx.error(
+                    ErrorKind::Structure(format!(
+                        "[initial] `{n}` is not a coordinate or a velocity of the model"
+                    )),
+                    Some(name.span()),
+                );
+                continue;
+            };
+            match initial_value(value.get_ref()) {
+                Ok(x) => out[slot] = x,
+                Err(why) => self.cx.error(
+                    ErrorKind::Structure(format!("[initial] `{n}`: {why}")),
+                    Some(value.span()),
+                ),
+            }
+        }
+        out
+    }
+
     fn declare(&mut self, name: &Spanned<String>, what: &'static str) {
         let n = name.get_ref();
         self.check_ident(n, name.span(), true);
@@ -825,6 +863,35 @@ fn tokens(s: &str) -> Vec<Token<'_>> {
 
 /// An exact rational from a TOML value: an integer, a string "p/q", an
 /// integer string, or a decimal (as a string or a TOML float), read exactly.
+/// An initial value: an exact number, or one times `pi` (`pi/2`, `-3*pi/4`).
+fn initial_value(n: &Number) -> Result<f64, String> {
+    let Number::Text(t) = n else {
+        return rational(n).map(Rational::to_f64);
+    };
+    let t: String = t.chars().filter(|c| !c.is_whitespace()).collect();
+    let Some((before, after)) = t.split_once("pi") else {
+        return rational(n).map(Rational::to_f64);
+    };
+    let coefficient = match before.strip_suffix('*').unwrap_or(before) {
+        "" => 1.0,
+        "-" => -1.0,
+        c => rational(&Number::Text(c.to_string()))?.to_f64(),
+    };
+    let divisor = match after.strip_prefix('/') {
+        None if after.is_empty() => 1.0,
+        Some(d) => rational(&Number::Text(d.to_string()))?.to_f64(),
+        None => {
+            return Err(format!(
+                "`{t}`: write a rational multiple of pi such as `pi/2` or `-3*pi/4`"
+            ));
+        }
+    };
+    if divisor == 0.0 {
+        return Err(format!("`{t}` divides by zero"));
+    }
+    Ok(coefficient * std::f64::consts::PI / divisor)
+}
+
 fn rational(n: &Number) -> Result<Rational, String> {
     let text = match n {
         Number::Int(i) => {

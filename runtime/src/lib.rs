@@ -120,6 +120,11 @@ pub trait Model<const Q: usize, const N: usize> {
     const VELOCITIES: &'static [&'static str];
     /// Names of the parameters, in order.
     const PARAMETERS: &'static [&'static str];
+    /// A starting configuration for simulations (the model file's
+    /// `[initial]` table).
+    const INITIAL_COORDINATES: [f64; Q] = [0.0; Q];
+    /// Starting velocities for simulations (the model file's `[initial]`).
+    const INITIAL_VELOCITIES: [f64; N] = [0.0; N];
 
     /// The model with the given parameters.
     fn with_params(params: Self::Params) -> Self;

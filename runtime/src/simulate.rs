@@ -219,6 +219,58 @@ pub enum SimError<W> {
     BadSettings,
 }
 
+impl<W: core::fmt::Debug> core::fmt::Display for SimError<W> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            SimError::Dynamics { t, error } => {
+                let what = match error {
+                    DynamicsError::NonFinite => "the state or the model's functions are not finite",
+                    DynamicsError::SingularMassMatrix => {
+                        "the mass matrix G(q) is singular (a coordinate singularity?)"
+                    }
+                    DynamicsError::DependentConstraints => "the constraint rows A(q) are dependent",
+                };
+                write!(f, "at t = {t}: {what}")
+            }
+            SimError::Inadmissible { residual } => write!(
+                f,
+                "the initial state is not admissible: |A q̇| = {:e}, |h(q)| = {:e} (or it is not finite)",
+                residual.velocity, residual.position
+            ),
+            SimError::StartsBeyondWall { wall, surface } => write!(
+                f,
+                "the initial state is beyond wall {wall:?} (f = {surface:e}) or on it moving in"
+            ),
+            SimError::Simultaneous { first, second, t } => write!(
+                f,
+                "at t = {t}: walls {first:?} and {second:?} are met at the same time; the collision law is for one wall at a time"
+            ),
+            SimError::Grazing {
+                wall,
+                t,
+                normal_velocity,
+            } => write!(
+                f,
+                "at t = {t}: grazing contact with wall {wall:?} (normal velocity {normal_velocity:e})"
+            ),
+            SimError::SingularWall { wall, t } => write!(
+                f,
+                "at t = {t}: the collision map of wall {wall:?} is singular here (B loses rank)"
+            ),
+            SimError::Projection { t, error } => {
+                write!(
+                    f,
+                    "at t = {t}: projection onto the constraints failed ({error:?})"
+                )
+            }
+            SimError::StepTooSmall { t, step } => {
+                write!(f, "at t = {t}: the step size fell to {step:e}")
+            }
+            SimError::BadSettings => write!(f, "a step or tolerance is not positive and finite"),
+        }
+    }
+}
+
 /// (q, q̇) or its time derivative (q̇, q̈).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Y<const N: usize> {

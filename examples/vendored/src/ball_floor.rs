@@ -60,6 +60,12 @@ impl BallFloor {
     pub const Q: usize = 0;
     /// Number of velocity components.
     pub const N: usize = 6;
+    /// The model file's initial coordinates (`[initial]`, zero where silent).
+    #[allow(clippy::approx_constant)]
+    pub const INITIAL_COORDINATES: [f64; 0] = [];
+    /// The model file's initial velocities (`[initial]`, zero where silent).
+    #[allow(clippy::approx_constant)]
+    pub const INITIAL_VELOCITIES: [f64; 6] = [0f64, 0f64, 0f64, 0f64, 0f64, 0f64];
     /// The model with the given parameters.
     pub const fn new(params: Params) -> Self {
         Self { params }
@@ -339,6 +345,8 @@ impl ::dalembert_runtime::Model<0, 6> for BallFloor {
     const COORDINATES: &'static [&'static str] = &[];
     const VELOCITIES: &'static [&'static str] = &["v1", "v2", "v3", "w1", "w2", "w3"];
     const PARAMETERS: &'static [&'static str] = &["m", "r", "J"];
+    const INITIAL_COORDINATES: [f64; 0] = Self::INITIAL_COORDINATES;
+    const INITIAL_VELOCITIES: [f64; 6] = Self::INITIAL_VELOCITIES;
     fn with_params(params: Params) -> Self {
         Self { params }
     }

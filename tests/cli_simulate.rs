@@ -1,0 +1,130 @@
+//! `dalembert simulate` end to end: files written, collisions recorded,
+//! parameters and initial values overridable, clear refusals.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn dalembert(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_dalembert"))
+        .args(args)
+        .output()
+        .expect("the CLI runs");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+#[test]
+fn writes_the_trajectory_and_the_plot() {
+    let dir = scratch("simulate-pendulum");
+    let out = dir.to_str().unwrap();
+    let (ok, stdout, stderr) =
+        dalembert(&["simulate", "pendulum_wall", "--t-end", "3", "--out", out]);
+    assert!(ok, "{stdout}\n{stderr}");
+    assert!(stdout.contains("collisions"), "{stdout}");
+    let csv = std::fs::read_to_string(dir.join("pendulum_wall.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "t,x,y,x_dot,y_dot,energy,residual_velocity,residual_position,collision"
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert!(rows.len() > 2000);
+    // Every row on the rod's circle; the bob bounces off the wall x = 1/2.
+    for r in &rows {
+        let (x, y): (f64, f64) = (r[1].parse().unwrap(), r[2].parse().unwrap());
+        assert!((x * x + y * y - 1.0).abs() < 1e-12);
+        assert!(x <= 0.5 + 1e-12);
+    }
+    let hits: Vec<_> = rows.iter().filter(|r| r[8] == "wall").collect();
+    assert!(!hits.is_empty());
+    for h in hits {
+        assert!((h[1].parse::<f64>().unwrap() - 0.5).abs() < 1e-12);
+    }
+    let svg = std::fs::read_to_string(dir.join("pendulum_wall.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.contains("energy drift") && svg.contains("<circle"));
+}
+
+/// t, coordinates and velocities of the CSV's last row.
+fn last_row(csv: &std::path::Path) -> Vec<f64> {
+    let text = std::fs::read_to_string(csv).unwrap();
+    let last = text.lines().last().unwrap();
+    last.split(',')
+        .take(5)
+        .map(|x| x.parse().unwrap())
+        .collect()
+}
+
+#[test]
+fn parameters_and_initial_values_can_be_set() {
+    let dir = scratch("simulate-masses");
+    let out = dir.to_str().unwrap();
+    // Equal masses exchange velocities.
+    let (ok, stdout, stderr) = dalembert(&[
+        "simulate",
+        "masses_on_line",
+        "--t-end",
+        "0.3",
+        "--set",
+        "m2=1",
+        "--set",
+        "x2_dot=0",
+        "--integrator",
+        "rk4",
+        "--step",
+        "0.01",
+        "--out",
+        out,
+    ]);
+    assert!(ok, "{stdout}\n{stderr}");
+    let last = last_row(&dir.join("masses_on_line.csv"));
+    // x1 = 1/5 moving at 1 meets x2 = 3/5 (at rest) at t = 0.4: at t = 0.3
+    // both are still in free flight.
+    assert!((last[1] - 0.5).abs() < 1e-12 && (last[2] - 0.6).abs() < 1e-12);
+    let (ok, stdout, _) = dalembert(&[
+        "simulate",
+        "masses_on_line",
+        "--t-end",
+        "0.5",
+        "--set",
+        "m2=1",
+        "--set",
+        "x2_dot=0",
+        "--out",
+        out,
+    ]);
+    assert!(ok);
+    assert!(stdout.contains(" 1 collisions"), "{stdout}");
+    // After the impact at t = 0.4 the velocities are exchanged.
+    let last = last_row(&dir.join("masses_on_line.csv"));
+    assert!(
+        last[3].abs() < 1e-12 && (last[4] - 1.0).abs() < 1e-12,
+        "{last:?}"
+    );
+}
+
+#[test]
+fn refuses_clearly() {
+    let (ok, _, stderr) = dalembert(&["simulate", "ball_wall"]);
+    assert!(!ok && stderr.contains("instantaneous model"), "{stderr}");
+    let (ok, _, stderr) = dalembert(&["simulate", "no_such_model"]);
+    assert!(
+        !ok && stderr.contains("ball_bounce") && stderr.contains("pendulum_wall"),
+        "{stderr}"
+    );
+    let (ok, _, stderr) = dalembert(&["simulate", "puck", "--set", "mass=2"]);
+    assert!(
+        !ok && stderr.contains("`mass` is not a parameter"),
+        "{stderr}"
+    );
+    let (ok, _, stderr) = dalembert(&["simulate", "pendulum_wall", "--set", "x=0.9"]);
+    assert!(!ok && stderr.contains("holonomic"), "{stderr}");
+}
