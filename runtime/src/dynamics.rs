@@ -5,11 +5,10 @@
 //! solved for q̈ and the constraint reaction λ at a state, without heap
 //! allocation. Differentiating A q̇ = 0 gives A q̈ = −Ȧq̇, so with
 //! z = −G⁻¹h and Y = G⁻¹Aᵀ, λ solves (A Y) λ = −Ȧq̇ − A z and q̈ = z + Y λ
-//! (both systems by Cholesky factorisation on fixed-size matrices).
-
-use nalgebra::{SMatrix, SVector};
+//! (both systems by Cholesky factorisation on fixed-size arrays).
 
 use crate::Model;
+use crate::linalg::{Cholesky, dot};
 
 /// Why the accelerations could not be computed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -54,36 +53,44 @@ pub fn accelerations<M: Model<N, N>, const N: usize>(
     if !g.iter().all(finite) || !finite(&h) || !a.as_slice().iter().all(finite) || !finite(&c) {
         return Err(DynamicsError::NonFinite);
     }
-    let chol = SMatrix::<f64, N, N>::from_fn(|i, j| g[i][j])
-        .cholesky()
-        .ok_or(DynamicsError::SingularMassMatrix)?;
-    let z = chol.solve(&SVector::<f64, N>::from_fn(|i, _| -h[i]));
+    let chol = Cholesky::new(&g, N).ok_or(DynamicsError::SingularMassMatrix)?;
+    let z = chol.solve(&h.map(|x| -x));
     let k = a.len();
-    // Y's columns G⁻¹aᵣᵀ; the k×k system padded to N×N with the identity.
-    let mut y = SMatrix::<f64, N, N>::zeros();
-    for (r, row) in a.as_slice().iter().enumerate() {
-        let col = chol.solve(&SVector::<f64, N>::from_fn(|i, _| row[i]));
-        y.set_column(r, &col);
+    if k == 0 {
+        return Ok(Accelerations {
+            qdd: z,
+            lambda: [0.0; N],
+            constraints: 0,
+        });
     }
-    let mut s = SMatrix::<f64, N, N>::identity();
-    let mut rhs = SVector::<f64, N>::zeros();
-    for (r, row) in a.as_slice().iter().enumerate() {
-        let ar = SVector::<f64, N>::from_fn(|i, _| row[i]);
+    // Y's columns G⁻¹aᵣᵀ, then the k×k system (A Y) λ = −Ȧq̇ − A z.
+    let rows = a.as_slice();
+    let mut y = [[0.0; N]; N];
+    for (yr, row) in y.iter_mut().zip(rows) {
+        *yr = chol.solve(row);
+    }
+    let mut s = [[0.0; N]; N];
+    let mut rhs = [0.0; N];
+    for (r, row) in rows.iter().enumerate() {
         for t in 0..k {
-            s[(r, t)] = ar.dot(&y.column(t));
+            s[r][t] = dot(row, &y[t]);
         }
-        rhs[r] = -c[r] - ar.dot(&z);
+        rhs[r] = -c[r] - dot(row, &z);
     }
     // A G⁻¹Aᵀ is symmetric, and positive definite exactly when A's rows
     // are independent.
-    let lambda = s
-        .cholesky()
+    let lambda = Cholesky::new(&s, k)
         .ok_or(DynamicsError::DependentConstraints)?
         .solve(&rhs);
-    let qdd = z + y * lambda;
+    let mut qdd = z;
+    for (yr, l) in y[..k].iter().zip(&lambda) {
+        for (q, yi) in qdd.iter_mut().zip(yr) {
+            *q += l * yi;
+        }
+    }
     let out = Accelerations {
-        qdd: core::array::from_fn(|i| qdd[i]),
-        lambda: core::array::from_fn(|i| if i < k { lambda[i] } else { 0.0 }),
+        qdd,
+        lambda,
         constraints: k,
     };
     if !finite(&out.qdd) || !finite(&out.lambda) {

@@ -36,6 +36,69 @@ pub fn kinetic_energy<const N: usize>(g: &[[f64; N]; N], v: &[f64; N]) -> f64 {
     0.5 * dot(v, &mat_vec(g, v))
 }
 
+/// The Cholesky factor L (G = L Lᵀ) of the leading `n`×`n` block of a
+/// symmetric positive definite matrix, on fixed-size arrays.
+///
+/// The equations of motion solve with it on every evaluation; on the
+/// 6×6 mass matrix of the ball in flight it is several times faster than
+/// nalgebra's general-purpose static Cholesky (measured with
+/// `cargo bench --bench simulate`, see docs/performance.md).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cholesky<const N: usize> {
+    l: [[f64; N]; N],
+    /// 1 / Lᵢᵢ: divisions are the slow part of a small factorisation.
+    inv: [f64; N],
+    n: usize,
+}
+
+impl<const N: usize> Cholesky<N> {
+    /// Factors the leading `n`×`n` block of `a` (the rest is ignored);
+    /// `None` unless that block is (numerically) positive definite.
+    pub fn new(a: &[[f64; N]; N], n: usize) -> Option<Self> {
+        let n = n.min(N);
+        let mut l = [[0.0; N]; N];
+        let mut inv = [0.0; N];
+        for i in 0..n {
+            for j in 0..=i {
+                let sum = a[i][j] - dot_prefix(&l[i], &l[j], j);
+                if i == j {
+                    // NaN fails the comparison too.
+                    if sum.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
+                        return None;
+                    }
+                    l[i][i] = libm::sqrt(sum);
+                    inv[i] = 1.0 / l[i][i];
+                } else {
+                    l[i][j] = sum * inv[j];
+                }
+            }
+        }
+        Some(Self { l, inv, n })
+    }
+
+    /// x with A x = b on the leading block (entries past it are zero).
+    pub fn solve(&self, b: &[f64; N]) -> [f64; N] {
+        let (l, n) = (&self.l, self.n);
+        let mut y = [0.0; N];
+        for i in 0..n {
+            y[i] = (b[i] - dot_prefix(&l[i], &y, i)) * self.inv[i];
+        }
+        for i in (0..n).rev() {
+            let mut sum = y[i];
+            for k in i + 1..n {
+                sum -= l[k][i] * y[k];
+            }
+            y[i] = sum * self.inv[i];
+        }
+        y
+    }
+}
+
+/// Σₖ₍ₖ<ₙ₎ aₖ bₖ.
+fn dot_prefix<const N: usize>(a: &[f64; N], b: &[f64; N], n: usize) -> f64 {
+    a[..n].iter().zip(&b[..n]).map(|(x, y)| x * y).sum()
+}
+
 /// Why [`projector`] could not compute P.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ProjectorError {
@@ -127,34 +190,31 @@ pub fn correction<const N: usize>(
         return Err(ProjectorError::NonFinite);
     }
     let k = rows.len().min(r.len()).min(N);
-    let chol = SMatrix::<f64, N, N>::from_fn(|i, j| g[i][j])
-        .cholesky()
-        .ok_or(ProjectorError::MassMatrixNotPositiveDefinite)?;
-    // Y's columns G⁻¹Rᵀ; the k×k system R Y μ = r padded to N×N.
-    let mut y = SMatrix::<f64, N, N>::zeros();
+    let chol = Cholesky::new(g, N).ok_or(ProjectorError::MassMatrixNotPositiveDefinite)?;
+    // Y's columns G⁻¹Rᵀ, then the k×k system (R Y) μ = r.
+    let mut y = [[0.0; N]; N];
     for (c, row) in rows[..k].iter().enumerate() {
-        y.set_column(
-            c,
-            &chol.solve(&nalgebra::SVector::<f64, N>::from_fn(|i, _| row[i])),
-        );
+        y[c] = chol.solve(row);
     }
-    let mut s = SMatrix::<f64, N, N>::identity();
-    let mut rhs = nalgebra::SVector::<f64, N>::zeros();
-    for (a, row) in rows[..k].iter().enumerate() {
-        let ra = nalgebra::SVector::<f64, N>::from_fn(|i, _| row[i]);
+    let mut s = [[0.0; N]; N];
+    let mut rhs = [0.0; N];
+    for a in 0..k {
         for b in 0..k {
-            s[(a, b)] = ra.dot(&y.column(b));
+            s[a][b] = dot(&rows[a], &y[b]);
         }
         rhs[a] = r[a];
     }
-    let mu = s
-        .cholesky()
+    let mu = Cholesky::new(&s, k)
         .ok_or(ProjectorError::DependentRows)?
         .solve(&rhs);
-    let delta = y * mu;
-    let out: [f64; N] = core::array::from_fn(|i| delta[i]);
-    if finite(&out) {
-        Ok(out)
+    let mut delta = [0.0; N];
+    for (c, yc) in y[..k].iter().enumerate() {
+        for (d, yi) in delta.iter_mut().zip(yc) {
+            *d += mu[c] * yi;
+        }
+    }
+    if finite(&delta) {
+        Ok(delta)
     } else {
         Err(ProjectorError::DependentRows)
     }

@@ -1,0 +1,98 @@
+//! Motion between collisions and the hybrid simulator, in one run:
+//!
+//! - `eom/<model>`: q̈ and λ at one state (`runtime::dynamics::accelerations`:
+//!   the generated G, h, A, Ȧq̇ and two fixed-size Cholesky solves);
+//! - `step/<model>/<method>`: one accepted integrator step, projection and
+//!   crossing checks included;
+//! - `simulate/ball_bounce_100_bounces`: the §3.2.1 nonholonomic pendulum
+//!   from the model file's initial state through 100 bounces (throughput in
+//!   bounces per second);
+//! - `simulate/rolling_ball_5s`: the §3.1 ball rolling under a uniform force
+//!   into the wall and back, 5 s of motion (throughput in steps per second).
+//!
+//! Run: `cargo bench --bench simulate`.
+
+use std::hint::black_box;
+
+use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
+use dalembert::models::{BallBounce, BallWallEuler, PendulumWall, Puck};
+use dalembert::runtime::Model;
+use dalembert::runtime::dynamics::accelerations;
+use dalembert::runtime::simulate::{Integrator, Settings, Simulator, State};
+
+fn initial<M: Model<N, N>, const N: usize>() -> State<N> {
+    State {
+        t: 0.0,
+        q: M::INITIAL_COORDINATES,
+        v: M::INITIAL_VELOCITIES,
+    }
+}
+
+fn eom<M: Model<N, N> + Default, const N: usize>(c: &mut Criterion) {
+    let m = M::default();
+    let s = initial::<M, N>();
+    c.bench_function(&format!("eom/{}", M::NAME), |b| {
+        b.iter(|| accelerations(black_box(&m), black_box(&s.q), black_box(&s.v)).unwrap())
+    });
+}
+
+fn rk4() -> Settings {
+    Settings {
+        integrator: Integrator::Rk4 { step: 1e-3 },
+        ..Settings::default()
+    }
+}
+
+fn step<M: Model<N, N> + Default, const N: usize>(c: &mut Criterion) {
+    let m = M::default();
+    for (name, settings) in [("dormand_prince", Settings::default()), ("rk4", rk4())] {
+        c.bench_function(&format!("step/{}/{name}", M::NAME), |b| {
+            b.iter_batched(
+                || Simulator::new(&m, initial::<M, N>(), settings).unwrap(),
+                |mut sim| black_box(sim.step(f64::INFINITY).unwrap()),
+                BatchSize::SmallInput,
+            )
+        });
+    }
+}
+
+fn simulate(c: &mut Criterion) {
+    let ball = BallBounce::default();
+    // §3.2.1 with the file's u = 2: a flight lasts 2u/g.
+    let flight = 2.0 * 2.0 / ball.params.g;
+    let bounces = 100;
+    let mut group = c.benchmark_group("simulate");
+    group.throughput(Throughput::Elements(bounces));
+    group.bench_function("ball_bounce_100_bounces", |b| {
+        b.iter(|| {
+            let mut sim =
+                Simulator::new(&ball, initial::<BallBounce, 6>(), Settings::default()).unwrap();
+            let stats = sim.run((bounces as f64 + 0.5) * flight, |_| true).unwrap();
+            assert_eq!(stats.collisions, bounces);
+            stats
+        })
+    });
+    let rolling = BallWallEuler::default();
+    let run = || {
+        let mut sim =
+            Simulator::new(&rolling, initial::<BallWallEuler, 5>(), Settings::default()).unwrap();
+        sim.run(5.0, |_| true).unwrap()
+    };
+    group.throughput(Throughput::Elements(run().steps));
+    group.bench_function("rolling_ball_5s", |b| b.iter(run));
+    group.finish();
+}
+
+fn all(c: &mut Criterion) {
+    eom::<BallBounce, 6>(c);
+    eom::<BallWallEuler, 5>(c);
+    eom::<PendulumWall, 2>(c);
+    eom::<Puck, 3>(c);
+    step::<BallBounce, 6>(c);
+    step::<BallWallEuler, 5>(c);
+    step::<PendulumWall, 2>(c);
+    simulate(c);
+}
+
+criterion_group!(benches, all);
+criterion_main!(benches);
