@@ -139,7 +139,25 @@ fn paper(models: &Path) -> Result<bool, String> {
         println!();
     }
     pendulum_demo();
-    Ok(all_ok)
+    println!();
+    Ok(all_ok && simulated_pendulum()?)
+}
+
+/// §3.2.1 simulated: the ball in flight (`models/ball_bounce.toml`) from the
+/// model file's initial state (just after a bounce, u = 2, v = 1) through
+/// 20 bounces, written to target/simulate/.
+fn simulated_pendulum() -> Result<bool, String> {
+    println!("==================== §3.2.1 simulated: 20 bounces of ball_bounce ====================");
+    let flight = 2.0 * 2.0 / <dalembert::models::BallBounce as Default>::default().params.g;
+    let t_end = format!("{}", 20.5 * flight);
+    let cli = Cli::try_parse_from([
+        "dalembert", "simulate", "ball_bounce", "--t-end", &t_end, "--path", "x,z",
+    ])
+    .map_err(|e| e.to_string())?;
+    match cli.command {
+        Command::Simulate(args) => sim::simulate(&args),
+        _ => unreachable!("parsed as `simulate`"),
+    }
 }
 
 /// §3.2.1 with the generated code itself: the paper's initial data must
