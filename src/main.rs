@@ -147,11 +147,22 @@ fn paper(models: &Path) -> Result<bool, String> {
 /// model file's initial state (just after a bounce, u = 2, v = 1) through
 /// 20 bounces, written to target/simulate/.
 fn simulated_pendulum() -> Result<bool, String> {
-    println!("==================== §3.2.1 simulated: 20 bounces of ball_bounce ====================");
-    let flight = 2.0 * 2.0 / <dalembert::models::BallBounce as Default>::default().params.g;
+    println!(
+        "==================== §3.2.1 simulated: 20 bounces of ball_bounce ===================="
+    );
+    let flight = 2.0 * 2.0
+        / <dalembert::models::BallBounce as Default>::default()
+            .params
+            .g;
     let t_end = format!("{}", 20.5 * flight);
     let cli = Cli::try_parse_from([
-        "dalembert", "simulate", "ball_bounce", "--t-end", &t_end, "--path", "x,z",
+        "dalembert",
+        "simulate",
+        "ball_bounce",
+        "--t-end",
+        &t_end,
+        "--path",
+        "x,z",
     ])
     .map_err(|e| e.to_string())?;
     match cli.command {
@@ -212,6 +223,10 @@ fn print_latex(d: &Derivation) -> Result<bool, String> {
     for w in &d.walls {
         println!("% wall `{}`", w.name);
         println!("B = {}", latex_matrix(&w.b_rows)?);
+        if w.structured {
+            println!("% P: structured evaluation (solved at run time from G and B)");
+            continue;
+        }
         println!("P = {}", latex_matrix(&w.projector)?);
         println!("\\begin{{aligned}}");
         for (name, c) in m.velocities.iter().zip(&w.collision) {
@@ -255,6 +270,12 @@ fn print_derivation(d: &Derivation) -> bool {
         print_matrix(&format!("B = (rows: {})", w.b_origin.join("; ")), &w.b_rows);
         if !w.dropped.is_empty() {
             println!("  dependent rows removed: {}", w.dropped.join("; "));
+        }
+        if w.structured {
+            println!(
+                "P and the collision map: structured evaluation (solved at run time from G and B; set `projector = \"symbolic\"` under [model] for closed forms)"
+            );
+            continue;
         }
         print_matrix("P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B =", &w.projector);
         println!("collision law v⁺ = (I − 2P)v⁻:");

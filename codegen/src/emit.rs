@@ -46,6 +46,12 @@ fn header(d: &Derivation) -> String {
     for (name, ops) in d.op_counts() {
         h.push_str(&format!("//   {name:<28} {ops}\n"));
     }
+    for w in d.walls.iter().filter(|w| w.structured) {
+        h.push_str(&format!(
+            "//   {:<28} structured: solved at run time from G and B\n",
+            format!("{}_projector, _collide", w.name)
+        ));
+    }
     h.push('\n');
     h
 }
@@ -234,6 +240,10 @@ fn wall_fns(d: &Derivation, w: &WallDerivation) -> TokenStream {
         &w.programs.rows,
         w.b_rows.len(),
     );
+    if w.structured {
+        let structured = structured_fns(d, w);
+        return quote! { #surface #rows #structured };
+    }
     let projector = fn_matrix(
         d,
         &format!("{name}_projector"),
@@ -248,6 +258,43 @@ fn wall_fns(d: &Derivation, w: &WallDerivation) -> TokenStream {
         &w.programs.collide,
     );
     quote! { #surface #rows #projector #collide }
+}
+
+/// P and the collision map of a wall evaluated at run time from the
+/// generated G and B by the runtime's fixed-size factorisations (NaN where
+/// B loses rank, as a closed form would divide by zero there).
+fn structured_fns(d: &Derivation, w: &WallDerivation) -> TokenStream {
+    let (q, n) = dims(d);
+    let (ql, nl) = (Literal::usize_unsuffixed(q), Literal::usize_unsuffixed(n));
+    let name = &w.name;
+    let projector = format_ident!("{name}_projector");
+    let collide = format_ident!("{name}_collide");
+    let rows = format_ident!("{name}_b_rows");
+    let p_doc = doc_attr(&format!(
+        "Wall `{name}`: the projector P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B, solved at run time from G and B (structured evaluation)."
+    ));
+    let c_doc = doc_attr(&format!(
+        "Wall `{name}`: the collision map v⁺ = v⁻ − 2G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹Bv⁻, solved at run time from G and B (structured evaluation)."
+    ));
+    quote! {
+        #p_doc
+        #[inline]
+        pub fn #projector(&self, q: &[f64; #ql]) -> [[f64; #nl]; #nl] {
+            let b = self.#rows(q);
+            ::dalembert_runtime::linalg::projector(&self.mass_matrix(q), b.as_slice())
+                .unwrap_or([[f64::NAN; #nl]; #nl])
+        }
+        #c_doc
+        #[inline]
+        pub fn #collide(&self, q: &[f64; #ql], v: &[f64; #nl]) -> [f64; #nl] {
+            let b = self.#rows(q);
+            let r = b.apply(v);
+            match ::dalembert_runtime::linalg::correction(&self.mass_matrix(q), b.as_slice(), r.as_slice()) {
+                Ok(d) => ::core::array::from_fn(|i| v[i] - 2.0 * d[i]),
+                Err(_) => [f64::NAN; #nl],
+            }
+        }
+    }
 }
 
 /// `q: &[f64; Q]` and, when the function takes velocities, `v: &[f64; N]`.
@@ -630,6 +677,9 @@ pub fn op_counts(d: &Derivation) -> Vec<(String, OpCount)> {
     for w in &d.walls {
         out.push((format!("{}_surface", w.name), w.programs.surface.op_count()));
         out.push((format!("{}_b_rows", w.name), w.programs.rows.op_count()));
+        if w.structured {
+            continue;
+        }
         out.push((
             format!("{}_projector", w.name),
             w.programs.projector.op_count(),

@@ -59,6 +59,7 @@ struct Header {
     name: Spanned<String>,
     #[serde(default)]
     doc: String,
+    projector: Option<Spanned<String>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -168,6 +169,20 @@ pub enum Kind {
     Instantaneous,
 }
 
+/// How the walls' P and collision maps are evaluated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ProjectorMode {
+    /// Symbolic while G is sparse (at most 2n non-zero entries off the
+    /// diagonal: any n ≤ 3, or a G that couples few velocities), structured
+    /// otherwise.
+    Auto,
+    /// P and (I − 2P)v derived exactly and emitted as closed forms.
+    Symbolic,
+    /// G and B emitted; P v solved at run time by a fixed-size
+    /// factorisation (for models whose symbolic P would be too large).
+    Structured,
+}
+
 /// A wall N = {f = 0} with its contact constraints.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Wall {
@@ -212,6 +227,8 @@ pub struct Model {
     pub constraints: Vec<Expr>,
     /// Walls in file order.
     pub walls: Vec<Wall>,
+    /// How P and the collision maps are evaluated.
+    pub projector: ProjectorMode,
     /// The initial state for simulations: one value per coordinate, then
     /// one per velocity (zero where the file's `[initial]` is silent).
     pub initial: Vec<f64>,
@@ -302,6 +319,24 @@ impl Validator<'_> {
             );
         }
 
+        let projector = match header
+            .projector
+            .as_ref()
+            .map(|p| (p.get_ref().as_str(), p.span()))
+        {
+            None | Some(("auto", _)) => ProjectorMode::Auto,
+            Some(("symbolic", _)) => ProjectorMode::Symbolic,
+            Some(("structured", _)) => ProjectorMode::Structured,
+            Some((other, span)) => {
+                self.cx.error(
+                    ErrorKind::Structure(format!(
+                        "[model] projector = `{other}`: write \"auto\", \"symbolic\" or \"structured\""
+                    )),
+                    Some(span),
+                );
+                ProjectorMode::Auto
+            }
+        };
         let params = self.params(&file.parameters);
         let (kind, coordinates, velocities) =
             self.variables(file.coordinates.as_ref(), file.velocities.as_ref());
@@ -346,6 +381,7 @@ impl Validator<'_> {
             holonomic,
             constraints,
             walls,
+            projector,
             initial,
             source: self.text.to_string(),
             file: path.to_path_buf(),

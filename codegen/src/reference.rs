@@ -84,6 +84,12 @@ impl Reference {
             .iter()
             .find(|w| w.name == self.wall)
             .ok_or_else(|| format!("model `{}` has no wall `{}`", d.model.name, self.wall))?;
+        if wall.structured {
+            return Err(format!(
+                "wall `{}` of `{}` has no closed-form P (structured evaluation): set `projector = \"symbolic\"` under [model]",
+                self.wall, d.model.name
+            ));
+        }
         let n = d.model.velocities.len();
         if self.projector.len() != n || self.projector.iter().any(|r| r.len() != n) {
             return Err(format!("the reference P must be {n}×{n}"));

@@ -21,7 +21,7 @@ use symbolica::evaluate::{Instruction, Slot as ESlot};
 use symbolica::prelude::*;
 
 use crate::diag::{Collector, ErrorKind, ModelErrors};
-use crate::ir::{Expr, FUNCTIONS, Kind, Model};
+use crate::ir::{Expr, FUNCTIONS, Kind, Model, ProjectorMode};
 use crate::program::{Func, Instr, OpCount, Program, Slot};
 
 type Rat = RationalPolynomial<IntegerRing, u16>;
@@ -96,6 +96,9 @@ pub struct WallDerivation {
     pub projector: Vec<Vec<String>>,
     /// v⁺ component by component, in terms of v⁻ (named as the velocities).
     pub collision: Vec<String>,
+    /// P v is solved at run time from G and B (no closed form; `projector`
+    /// and `collision` are empty).
+    pub structured: bool,
     /// Programs.
     pub programs: WallPrograms,
 }
@@ -297,16 +300,27 @@ impl<'a> Deriver<'a> {
             &inputs,
         )?;
         self.check_positive_definite(&mass_matrix, n);
-        let g_inv = match g_mat.inv() {
-            Ok(i) => i,
-            Err(_) => {
-                self.cx.error(
-                    ErrorKind::NotPositiveDefinite {
-                        at: "every configuration (G is singular)".into(),
-                    },
-                    Some(m.kinetic_energy.span.clone()),
-                );
-                return None;
+        let structured = match m.projector {
+            ProjectorMode::Symbolic => false,
+            ProjectorMode::Structured => true,
+            ProjectorMode::Auto => off_diagonal_entries(&g_simpl) > 2 * n,
+        };
+        // The exact G⁻¹ is what makes a symbolic P expensive; structured
+        // evaluation never needs it (G > 0 is checked numerically above).
+        let g_inv = if structured {
+            None
+        } else {
+            match g_mat.inv() {
+                Ok(i) => Some(i),
+                Err(_) => {
+                    self.cx.error(
+                        ErrorKind::NotPositiveDefinite {
+                            at: "every configuration (G is singular)".into(),
+                        },
+                        Some(m.kinetic_energy.span.clone()),
+                    );
+                    return None;
+                }
             }
         };
 
@@ -334,14 +348,6 @@ impl<'a> Deriver<'a> {
                 n,
                 &field,
             )?;
-            let p = projector(&g_inv, &b)?;
-            let p_atoms: Vec<Vec<Atom>> = (0..n)
-                .map(|i| {
-                    (0..n)
-                        .map(|j| self.simplify(&p[(i as u32, j as u32)], &vars))
-                        .collect()
-                })
-                .collect();
             let b_atoms: Vec<Vec<Atom>> = kept
                 .iter()
                 .map(|(r, _)| r.iter().map(|x| self.raise(&x.to_expression())).collect())
@@ -349,15 +355,32 @@ impl<'a> Deriver<'a> {
             if m.kind == Kind::Coordinates {
                 self.check_on_wall(w, &surface, &normal, &a_rows, &b_atoms);
             }
-            let collide: Vec<Atom> = (0..n)
-                .map(|i| {
-                    let mut s = Atom::from(self.vels[i]);
-                    for j in 0..n {
-                        s -= Atom::num(2) * p_atoms[i][j].clone() * Atom::from(self.vels[j]);
-                    }
-                    s
-                })
-                .collect();
+            // Symbolic: P and (I − 2P)v in closed form. Structured: neither;
+            // the emitter solves for P v at run time from G and B.
+            let (p_atoms, collide) = match &g_inv {
+                Some(g_inv) => {
+                    let p = projector(g_inv, &b)?;
+                    let p_atoms: Vec<Vec<Atom>> = (0..n)
+                        .map(|i| {
+                            (0..n)
+                                .map(|j| self.simplify(&p[(i as u32, j as u32)], &vars))
+                                .collect()
+                        })
+                        .collect();
+                    let collide: Vec<Atom> = (0..n)
+                        .map(|i| {
+                            let mut s = Atom::from(self.vels[i]);
+                            for j in 0..n {
+                                s -=
+                                    Atom::num(2) * p_atoms[i][j].clone() * Atom::from(self.vels[j]);
+                            }
+                            s
+                        })
+                        .collect();
+                    (p_atoms, collide)
+                }
+                None => (Vec::new(), Vec::new()),
+            };
             let programs = WallPrograms {
                 surface: self.program(std::slice::from_ref(&surface), &inputs)?,
                 rows: self.program(
@@ -379,6 +402,7 @@ impl<'a> Deriver<'a> {
                 dropped,
                 projector: strings2(&p_atoms),
                 collision: collide.iter().map(|c| self.collect_velocities(c)).collect(),
+                structured: g_inv.is_none(),
                 programs,
             });
         }
@@ -941,6 +965,21 @@ fn independent_rows(
 }
 
 /// P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B.
+/// Number of non-zero entries off the diagonal. A symbolic G⁻¹ (and so P)
+/// stays small while G is this sparse; the chain family measures how fast
+/// it grows when G is dense (docs/performance.md).
+fn off_diagonal_entries(g: &[Vec<Atom>]) -> usize {
+    g.iter()
+        .enumerate()
+        .map(|(i, row)| {
+            row.iter()
+                .enumerate()
+                .filter(|(j, a)| i != *j && !is_zero(a))
+                .count()
+        })
+        .sum()
+}
+
 fn projector(g_inv: &Matrix<Field>, b: &Matrix<Field>) -> Option<Matrix<Field>> {
     let x = g_inv * &b.transpose();
     let m = b * &x;
