@@ -8,6 +8,8 @@
 //! - `generic_dynamic`: P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B with nalgebra's heap-allocated
 //!   dynamic matrices on every call, then (I − 2P)v.
 //!
+//! - `chain_collide/chain_N`: the n-link chain family's collision map.
+//!
 //! Run: `cargo bench --bench collision`.
 
 use std::hint::black_box;
@@ -123,5 +125,35 @@ fn section_3_2(c: &mut Criterion) {
     compare(c, "collision_3_2", &ball, v, hand);
 }
 
-criterion_group!(benches, section_3_1, section_3_2);
+/// The n-link chain family: the collision map at the model file's initial
+/// configuration, n = 1…8 (closed forms for n ≤ 3, structured above), and
+/// chain_4 with its closed form for comparison.
+fn chains(c: &mut Criterion) {
+    fn one<M: Model<N, N> + Default, const N: usize>(
+        g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    ) {
+        let m = M::default();
+        let q = M::INITIAL_COORDINATES;
+        let v: [f64; N] = std::array::from_fn(|i| 0.3 - 0.1 * i as f64);
+        let w = M::WALLS[0];
+        assert!(m.collide(w, &q, &v).iter().all(|x| x.is_finite()));
+        g.bench_function(M::NAME, |b| {
+            b.iter(|| m.collide(w, black_box(&q), black_box(&v)))
+        });
+    }
+    use dalembert::models::*;
+    let mut g = c.benchmark_group("chain_collide");
+    one::<Chain1, 1>(&mut g);
+    one::<Chain2, 2>(&mut g);
+    one::<Chain3, 3>(&mut g);
+    one::<Chain4, 4>(&mut g);
+    one::<Chain4Symbolic, 4>(&mut g);
+    one::<Chain5, 5>(&mut g);
+    one::<Chain6, 6>(&mut g);
+    one::<Chain7, 7>(&mut g);
+    one::<Chain8, 8>(&mut g);
+    g.finish();
+}
+
+criterion_group!(benches, section_3_1, section_3_2, chains);
 criterion_main!(benches);
