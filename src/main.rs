@@ -57,6 +57,11 @@ enum Command {
         /// there on first use.
         #[arg(short, long)]
         output: Option<PathBuf>,
+        /// Emit f32 arithmetic (for microcontrollers without double-precision
+        /// hardware): the model's inherent functions, without the f64 `Model`
+        /// trait; needs closed-form P (accuracy: docs/performance.md).
+        #[arg(long)]
+        f32: bool,
     },
     /// Compare a model's derived P (and collision law) with a reference file.
     Check {
@@ -76,7 +81,7 @@ fn main() -> ExitCode {
         Command::Paper { models } => paper(&models),
         Command::Derive { file, latex: false } => derive_timed(&file),
         Command::Derive { file, latex: true } => derive(&file).and_then(|d| print_latex(&d)),
-        Command::Generate { file, output } => generate(&file, output.as_deref()),
+        Command::Generate { file, output, f32 } => generate(&file, output.as_deref(), f32),
         Command::Check { file, reference } => check(&file, &reference),
         Command::Simulate(args) => sim::simulate(&args),
     };
@@ -111,8 +116,13 @@ fn derive_timed(file: &Path) -> Result<bool, String> {
     Ok(true)
 }
 
-fn generate(file: &Path, output: Option<&Path>) -> Result<bool, String> {
-    let code = dalembert_codegen::generate(file).map_err(|e| e.render())?;
+fn generate(file: &Path, output: Option<&Path>, f32: bool) -> Result<bool, String> {
+    let code = if f32 {
+        dalembert_codegen::generate_f32(file)
+    } else {
+        dalembert_codegen::generate(file)
+    }
+    .map_err(|e| e.render())?;
     match output {
         Some(path) => std::fs::write(path, code).map_err(|e| format!("{}: {e}", path.display()))?,
         None => print!("{code}"),

@@ -7,12 +7,8 @@ use dalembert::models::{Chain4, Chain4Symbolic};
 use dalembert::models::{chain_4, chain_4_symbolic};
 use dalembert::runtime::Model;
 
-fn lcg(state: &mut u64) -> f64 {
-    *state = state
-        .wrapping_mul(6364136223846793005)
-        .wrapping_add(1442695040888963407);
-    (*state >> 11) as f64 / (1u64 << 53) as f64
-}
+mod common;
+use common::lcg;
 
 /// chain_4 structured vs chain_4_symbolic (the same model with its closed-form
 /// P): P and the collision map agree at random configurations, velocities

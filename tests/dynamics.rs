@@ -10,14 +10,7 @@ use dalembert::runtime::Model;
 use dalembert::runtime::dynamics::{DynamicsError, accelerations};
 
 mod common;
-use common::onto_kernel;
-
-fn lcg(state: &mut u64) -> f64 {
-    *state = state
-        .wrapping_mul(6364136223846793005)
-        .wrapping_add(1442695040888963407);
-    (*state >> 11) as f64 / (1u64 << 53) as f64
-}
+use common::{lcg, onto_kernel};
 
 /// v projected onto ker A(q).
 fn admissible<M: Model<N, N>, const N: usize>(m: &M, q: &[f64; N], v: [f64; N]) -> [f64; N] {

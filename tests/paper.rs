@@ -12,6 +12,9 @@ use dalembert_codegen::reference::{Difference, Reference};
 use dalembert_codegen::symbolic::{eval, same, substitute};
 use dalembert_codegen::{Derivation, derive};
 
+mod common;
+use common::lcg;
+
 fn model_file(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("models")
@@ -144,13 +147,6 @@ fn euler_angle_ball_agrees_with_the_paper_model() {
 }
 
 /// A small deterministic generator for test points.
-fn lcg(state: &mut u64) -> f64 {
-    *state = state
-        .wrapping_mul(6364136223846793005)
-        .wrapping_add(1442695040888963407);
-    (*state >> 11) as f64 / (1u64 << 53) as f64
-}
-
 /// The generated projector and collision map agree with symbolica's own
 /// evaluation of the symbolic P and (I − 2P)v at random parameters,
 /// configurations and velocities.

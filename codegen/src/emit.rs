@@ -25,6 +25,42 @@ pub fn file(d: &Derivation) -> String {
     format!("{}{}", header(d), prettyplease::unparse(&file))
 }
 
+/// The float type of emitted code.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Scalar {
+    /// f64: implements `dalembert_runtime::Model`.
+    F64,
+    /// f32, for microcontrollers without double-precision hardware: the
+    /// model's inherent functions only (the runtime is f64), constraint
+    /// rows as `([[f32; N]; N], rows in use)`; closed-form P only.
+    F32,
+}
+
+/// `f64` or `f32`.
+fn real(d: &Derivation) -> TokenStream {
+    match d.scalar {
+        Scalar::F64 => quote! { f64 },
+        Scalar::F32 => quote! { f32 },
+    }
+}
+
+/// A float literal of the emitted type.
+fn lit(d: &Derivation, x: f64) -> Literal {
+    match d.scalar {
+        Scalar::F64 => Literal::f64_suffixed(x),
+        Scalar::F32 => Literal::f32_suffixed(x as f32),
+    }
+}
+
+/// libm's function `name` for the emitted type (`sin` or `sinf`).
+fn libm_fn(d: &Derivation, name: &str) -> TokenStream {
+    let f = match d.scalar {
+        Scalar::F64 => format_ident!("{name}"),
+        Scalar::F32 => format_ident!("{name}f"),
+    };
+    quote! { ::dalembert_runtime::libm::#f }
+}
+
 /// The `@generated` header: where the file came from, the model's doc text and
 /// the operation counts of every emitted function.
 fn header(d: &Derivation) -> String {
@@ -42,7 +78,7 @@ fn header(d: &Derivation) -> String {
     for line in m.doc.lines() {
         h.push_str(&format!("// {line}\n").replace("// \n", "//\n"));
     }
-    h.push_str("//\n// Operation counts (f64):\n");
+    h.push_str(&format!("//\n// Operation counts ({}):\n", real(d)));
     for (name, ops) in d.op_counts() {
         h.push_str(&format!("//   {name:<28} {ops}\n"));
     }
@@ -62,7 +98,12 @@ fn model_tokens(d: &Derivation) -> TokenStream {
     let ty = format_ident!("{}", d.model.type_name());
     let doc = doc_attr(&d.model.doc);
     let inherent = inherent_impl(d);
-    let trait_impl = trait_impl(d);
+    // The runtime's trait and numerics are f64: an f32 model is its
+    // inherent functions.
+    let trait_impl = match d.scalar {
+        Scalar::F64 => trait_impl(d),
+        Scalar::F32 => TokenStream::new(),
+    };
     quote! {
         #params
         #walls
@@ -94,16 +135,17 @@ fn params_struct(d: &Derivation) -> TokenStream {
         .model
         .params
         .iter()
-        .map(|p| Literal::f64_suffixed(p.value.to_f64()))
+        .map(|p| lit(d, p.value.to_f64()))
         .collect();
     let model = &d.model.name;
+    let real = real(d);
     let sdoc = format!(" Parameters of `{model}`; `Default` gives the model file's values.");
     quote! {
         #[doc = #sdoc]
         #[allow(non_snake_case)]
         #[derive(Clone, Copy, Debug, PartialEq)]
         pub struct Params {
-            #( #docs pub #names: f64, )*
+            #( #docs pub #names: #real, )*
         }
         impl Default for Params {
             fn default() -> Self {
@@ -189,12 +231,9 @@ fn inherent_impl(d: &Derivation) -> TokenStream {
     let walls = d.walls.iter().map(|w| wall_fns(d, w));
     let qn = Literal::usize_unsuffixed(q);
     let nn = Literal::usize_unsuffixed(n);
-    let init_q = d.model.initial[..q]
-        .iter()
-        .map(|x| Literal::f64_suffixed(*x));
-    let init_v = d.model.initial[q..]
-        .iter()
-        .map(|x| Literal::f64_suffixed(*x));
+    let init_q = d.model.initial[..q].iter().map(|x| lit(d, *x));
+    let init_v = d.model.initial[q..].iter().map(|x| lit(d, *x));
+    let real = real(d);
     quote! {
         impl #ty {
             /// Number of coordinates.
@@ -203,10 +242,10 @@ fn inherent_impl(d: &Derivation) -> TokenStream {
             pub const N: usize = #nn;
             /// The model file's initial coordinates (`[initial]`, zero where silent).
             #[allow(clippy::approx_constant)]
-            pub const INITIAL_COORDINATES: [f64; #qn] = [#(#init_q),*];
+            pub const INITIAL_COORDINATES: [#real; #qn] = [#(#init_q),*];
             /// The model file's initial velocities (`[initial]`, zero where silent).
             #[allow(clippy::approx_constant)]
-            pub const INITIAL_VELOCITIES: [f64; #nn] = [#(#init_v),*];
+            pub const INITIAL_VELOCITIES: [#real; #nn] = [#(#init_v),*];
             /// The model with the given parameters.
             pub const fn new(params: Params) -> Self {
                 Self { params }
@@ -302,10 +341,11 @@ fn args(d: &Derivation, with_v: bool) -> TokenStream {
     let (q, n) = dims(d);
     let q = Literal::usize_unsuffixed(q);
     let n = Literal::usize_unsuffixed(n);
+    let real = real(d);
     if with_v {
-        quote! { q: &[f64; #q], v: &[f64; #n] }
+        quote! { q: &[#real; #q], v: &[#real; #n] }
     } else {
-        quote! { q: &[f64; #q] }
+        quote! { q: &[#real; #q] }
     }
 }
 
@@ -333,7 +373,7 @@ fn function(
 }
 
 fn fn_scalar(d: &Derivation, name: &str, doc: &str, p: &Program, with_v: bool) -> TokenStream {
-    function(d, name, doc, p, with_v, quote! { f64 }, quote! { o0 })
+    function(d, name, doc, p, with_v, real(d), quote! { o0 })
 }
 
 /// A function of (q, v) returning an n-vector: the program's outputs, padded
@@ -348,7 +388,10 @@ fn fn_vector(d: &Derivation, name: &str, doc: &str, p: &Program) -> TokenStream 
         doc,
         p,
         true,
-        quote! { [f64; #nl] },
+        {
+            let real = real(d);
+            quote! { [#real; #nl] }
+        },
         quote! { [#(#outs),*] },
     )
 }
@@ -377,8 +420,14 @@ fn fn_values(d: &Derivation, name: &str, doc: &str, p: &Program) -> TokenStream 
         doc,
         p,
         false,
-        quote! { ::dalembert_runtime::Rows1<#nl> },
-        quote! { ::dalembert_runtime::Rows1::new([#(#outs),*], #kl) },
+        match d.scalar {
+            Scalar::F64 => quote! { ::dalembert_runtime::Rows1<#nl> },
+            Scalar::F32 => quote! { ([f32; #nl], usize) },
+        },
+        match d.scalar {
+            Scalar::F64 => quote! { ::dalembert_runtime::Rows1::new([#(#outs),*], #kl) },
+            Scalar::F32 => quote! { ([#(#outs),*], #kl) },
+        },
     )
 }
 
@@ -395,7 +444,10 @@ fn fn_matrix(d: &Derivation, name: &str, doc: &str, p: &Program, n: usize) -> To
         doc,
         p,
         false,
-        quote! { [[f64; #nl]; #nl] },
+        {
+            let real = real(d);
+            quote! { [[#real; #nl]; #nl] }
+        },
         quote! { [#(#rows),*] },
     )
 }
@@ -419,8 +471,14 @@ fn fn_rows(d: &Derivation, name: &str, doc: &str, p: &Program, k: usize) -> Toke
         doc,
         p,
         false,
-        quote! { ::dalembert_runtime::Rows<#nl> },
-        quote! { ::dalembert_runtime::Rows::new([#(#rows),*], #kl) },
+        match d.scalar {
+            Scalar::F64 => quote! { ::dalembert_runtime::Rows<#nl> },
+            Scalar::F32 => quote! { ([[f32; #nl]; #nl], usize) },
+        },
+        match d.scalar {
+            Scalar::F64 => quote! { ::dalembert_runtime::Rows::new([#(#rows),*], #kl) },
+            Scalar::F32 => quote! { ([#(#rows),*], #kl) },
+        },
     )
 }
 
@@ -437,9 +495,10 @@ fn body(d: &Derivation, p: &Program) -> TokenStream {
     let inputs = used.iter().enumerate().filter(|(_, u)| **u).map(|(i, _)| {
         let name = format_ident!("i{i}");
         let value = input_value(d, i);
-        quote! { let #name: f64 = #value; }
+        let real = real(d);
+        quote! { let #name: #real = #value; }
     });
-    let stmts = p.instrs.iter().map(|ins| instr(p, ins));
+    let stmts = p.instrs.iter().map(|ins| instr(d, p, ins));
     quote! { #(#inputs)* #(#stmts)* }
 }
 
@@ -467,37 +526,38 @@ fn input_value(d: &Derivation, i: usize) -> TokenStream {
     }
 }
 
-fn slot(p: &Program, s: Slot) -> TokenStream {
+fn slot(d: &Derivation, p: &Program, s: Slot) -> TokenStream {
     let name = match s {
         Slot::Input(i) => format_ident!("i{i}"),
         Slot::Temp(i) => format_ident!("t{i}"),
         Slot::Out(i) => format_ident!("o{i}"),
         Slot::Const(i) => {
-            let lit = Literal::f64_suffixed(p.consts[i]);
+            let lit = lit(d, p.consts[i]);
             return quote! { #lit };
         }
     };
     quote! { #name }
 }
 
-fn instr(p: &Program, ins: &Instr) -> TokenStream {
+fn instr(d: &Derivation, p: &Program, ins: &Instr) -> TokenStream {
     let (dst, value) = match ins {
-        Instr::Add(d, s) => (*d, join(s.iter().map(|&x| slot(p, x)), quote! { + })),
-        Instr::Mul(d, s) => (*d, product(p, s)),
-        Instr::Pow(d, s, n) => (*d, pow(slot(p, *s), *n)),
-        Instr::Fun(d, f, s) => {
-            let f = format_ident!("{}", f.name());
-            let s = slot(p, *s);
-            (*d, quote! { ::dalembert_runtime::libm::#f(#s) })
+        Instr::Add(o, s) => (*o, join(s.iter().map(|&x| slot(d, p, x)), quote! { + })),
+        Instr::Mul(o, s) => (*o, product(d, p, s)),
+        Instr::Pow(o, s, n) => (*o, pow(d, slot(d, p, *s), *n)),
+        Instr::Fun(o, f, s) => {
+            let f = libm_fn(d, f.name());
+            let s = slot(d, p, *s);
+            (*o, quote! { #f(#s) })
         }
-        Instr::Assign(d, s) => (*d, slot(p, *s)),
+        Instr::Assign(o, s) => (*o, slot(d, p, *s)),
     };
-    let dst = slot(p, dst);
-    quote! { let #dst: f64 = #value; }
+    let dst = slot(d, p, dst);
+    let real = real(d);
+    quote! { let #dst: #real = #value; }
 }
 
 /// A product; a factor −1 becomes a negation.
-fn product(p: &Program, factors: &[Slot]) -> TokenStream {
+fn product(d: &Derivation, p: &Program, factors: &[Slot]) -> TokenStream {
     let minus_one = |s: &Slot| matches!(s, Slot::Const(i) if p.consts[*i] == -1.0);
     let rest: Vec<Slot> = factors.iter().copied().filter(|s| !minus_one(s)).collect();
     let negations = factors.len() - rest.len();
@@ -508,7 +568,7 @@ fn product(p: &Program, factors: &[Slot]) -> TokenStream {
             quote! { 1.0 }
         };
     }
-    let prod = join(rest.iter().map(|&x| slot(p, x)), quote! { * });
+    let prod = join(rest.iter().map(|&x| slot(d, p, x)), quote! { * });
     if negations % 2 == 1 {
         quote! { -(#prod) }
     } else {
@@ -528,7 +588,7 @@ fn join(operands: impl Iterator<Item = TokenStream>, op: TokenStream) -> TokenSt
     out
 }
 
-fn pow(x: TokenStream, n: i64) -> TokenStream {
+fn pow(d: &Derivation, x: TokenStream, n: i64) -> TokenStream {
     let m = n.unsigned_abs();
     let positive = if m == 0 {
         quote! { 1.0 }
@@ -536,8 +596,9 @@ fn pow(x: TokenStream, n: i64) -> TokenStream {
         let product = join(std::iter::repeat_n(x.clone(), m as usize), quote! { * });
         quote! { (#product) }
     } else {
-        let e = Literal::f64_suffixed(m as f64);
-        quote! { ::dalembert_runtime::libm::pow(#x, #e) }
+        let e = lit(d, m as f64);
+        let f = libm_fn(d, "pow");
+        quote! { #f(#x, #e) }
     };
     if n < 0 {
         quote! { 1.0 / #positive }

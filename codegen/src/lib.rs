@@ -41,6 +41,27 @@ pub fn generate(path: &Path) -> Result<String, ModelErrors> {
     Ok(emit::file(&d))
 }
 
+/// The formatted Rust source for the model in `path` with `f32` arithmetic
+/// (for microcontrollers without double-precision hardware): the model's
+/// inherent functions, without the f64 `Model` trait. Every wall needs a
+/// closed-form P (structured evaluation uses the runtime's f64 numerics).
+pub fn generate_f32(path: &Path) -> Result<String, ModelErrors> {
+    let mut d = derive(path)?;
+    if let Some(w) = d.walls.iter().find(|w| w.structured) {
+        let mut cx = diag::Collector::new(&d.model.file, &d.model.source);
+        cx.error(
+            ErrorKind::Structure(format!(
+                "f32 generation needs a closed-form P, and wall `{}` is structured: set `projector = \"symbolic\"` under [model]",
+                w.name
+            )),
+            None,
+        );
+        return Err(cx.into_errors());
+    }
+    d.scalar = emit::Scalar::F32;
+    Ok(emit::file(&d))
+}
+
 /// One model's generated file and what it took to make it.
 #[derive(Debug, Clone)]
 pub struct Generated {

@@ -42,6 +42,9 @@ pub struct Derivation {
     pub walls: Vec<WallDerivation>,
     /// Programs for the model-wide functions.
     pub programs: Programs,
+    /// The float type the emitter writes (an emission choice, kept here so
+    /// that every emitting function sees it; `F64` from `derive`).
+    pub scalar: crate::emit::Scalar,
 }
 
 /// Programs for the model-wide functions.
@@ -421,6 +424,7 @@ impl<'a> Deriver<'a> {
             holonomic: self.program(&holonomic, &inputs)?,
         };
         Some(Derivation {
+            scalar: crate::emit::Scalar::F64,
             model: m.clone(),
             mass_matrix: strings2(&g_simpl),
             constraint_rows: strings2(&a_rows),

@@ -1,5 +1,7 @@
 //! Helpers shared by the integration tests.
 
+#![allow(dead_code)] // each test binary uses some of these
+
 use dalembert::runtime::Rows;
 use nalgebra::DMatrix;
 
@@ -18,4 +20,13 @@ pub fn onto_kernel<const N: usize>(a: &Rows<N>, v: [f64; N]) -> [f64; N] {
         .expect("A has full row rank");
     let w = vv - am.transpose() * lam;
     std::array::from_fn(|i| w[(i, 0)])
+}
+
+/// A small deterministic generator of numbers in [0, 1) (a linear
+/// congruential generator: reproducible test inputs without a dependency).
+pub fn lcg(state: &mut u64) -> f64 {
+    *state = state
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    (*state >> 11) as f64 / (1u64 << 53) as f64
 }

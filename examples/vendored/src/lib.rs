@@ -12,3 +12,18 @@
 
 pub mod ball_floor;
 pub use ball_floor::BallFloor;
+
+/// Single-precision versions for microcontrollers without double-precision
+/// hardware, written by
+///
+/// ```sh
+/// cargo run --release -- generate models/ball_floor.toml --f32 -o examples/vendored/src/single/ball_floor.rs
+/// cargo run --release -- generate models/ball_wall_euler.toml --f32 -o examples/vendored/src/single/ball_wall_euler.rs
+/// ```
+///
+/// the models' inherent functions in f32 (accuracy against f64:
+/// docs/performance.md, checked by the workspace's `tests/vendored.rs`).
+pub mod single {
+    pub mod ball_floor;
+    pub mod ball_wall_euler;
+}
