@@ -413,22 +413,35 @@ fn fn_values(d: &Derivation, name: &str, doc: &str, p: &Program) -> TokenStream 
     let n = d.model.velocities.len();
     let outs = padded_outputs(p, n);
     let nl = Literal::usize_unsuffixed(n);
-    let kl = Literal::usize_unsuffixed(p.outputs);
-    function(
+    let (ret, result) = counted(
         d,
-        name,
-        doc,
-        p,
-        false,
-        match d.scalar {
-            Scalar::F64 => quote! { ::dalembert_runtime::Rows1<#nl> },
-            Scalar::F32 => quote! { ([f32; #nl], usize) },
-        },
-        match d.scalar {
-            Scalar::F64 => quote! { ::dalembert_runtime::Rows1::new([#(#outs),*], #kl) },
-            Scalar::F32 => quote! { ([#(#outs),*], #kl) },
-        },
-    )
+        "Rows1",
+        quote! { [f32; #nl] },
+        quote! { [#(#outs),*] },
+        p.outputs,
+    );
+    function(d, name, doc, p, false, ret, result)
+}
+
+/// Return type and value of `k` rows or values in use out of `array`: the
+/// runtime's `Rows`/`Rows1` (`runtime`) in f64, `(array, k)` in f32.
+fn counted(
+    d: &Derivation,
+    runtime: &str,
+    f32_type: TokenStream,
+    array: TokenStream,
+    k: usize,
+) -> (TokenStream, TokenStream) {
+    let n = Literal::usize_unsuffixed(d.model.velocities.len());
+    let k = Literal::usize_unsuffixed(k);
+    let runtime = format_ident!("{runtime}");
+    match d.scalar {
+        Scalar::F64 => (
+            quote! { ::dalembert_runtime::#runtime<#n> },
+            quote! { ::dalembert_runtime::#runtime::new(#array, #k) },
+        ),
+        Scalar::F32 => (quote! { (#f32_type, usize) }, quote! { (#array, #k) }),
+    }
 }
 
 /// A function returning an n×n matrix from a program with n² outputs.
@@ -464,22 +477,14 @@ fn fn_rows(d: &Derivation, name: &str, doc: &str, p: &Program, k: usize) -> Toke
         }
     });
     let nl = Literal::usize_unsuffixed(n);
-    let kl = Literal::usize_unsuffixed(k);
-    function(
+    let (ret, result) = counted(
         d,
-        name,
-        doc,
-        p,
-        false,
-        match d.scalar {
-            Scalar::F64 => quote! { ::dalembert_runtime::Rows<#nl> },
-            Scalar::F32 => quote! { ([[f32; #nl]; #nl], usize) },
-        },
-        match d.scalar {
-            Scalar::F64 => quote! { ::dalembert_runtime::Rows::new([#(#rows),*], #kl) },
-            Scalar::F32 => quote! { ([#(#rows),*], #kl) },
-        },
-    )
+        "Rows",
+        quote! { [[f32; #nl]; #nl] },
+        quote! { [#(#rows),*] },
+        k,
+    );
+    function(d, name, doc, p, false, ret, result)
 }
 
 /// Statements computing `o0, o1, …` from the program.
