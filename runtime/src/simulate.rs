@@ -802,7 +802,15 @@ impl<'m, M: Model<N, N>, const N: usize> Simulator<'m, M, N> {
             let y = state(theta);
             m.normal_velocity(wall, &y.q, &y.v)
         };
-        let sample = |theta: f64| (theta, f(theta), rate(theta));
+        // One dense-output evaluation per sample for both f and its rate.
+        let sample = |theta: f64| {
+            let y = state(theta);
+            (
+                theta,
+                m.surface(wall, &y.q),
+                m.normal_velocity(wall, &y.q, &y.v),
+            )
+        };
         let n = self.settings.samples + 1;
         let mut prev = sample(0.0);
         let mut leaving = self.departing & (1 << k) != 0 && prev.1 <= 0.0 && prev.2 > 0.0;
