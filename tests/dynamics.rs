@@ -3,14 +3,21 @@
 //! they were derived: the energy T + V is constant along the motion (the
 //! reactions do no work on admissible velocities), A q̇ stays zero to second
 //! order, both by finite differences of the generated T, V and A; and the
-//! analytic motion of the Chaplygin sleigh (puck).
+//! analytic motion of the Chaplygin sleigh (puck). The generated closed
+//! forms of q̈ are checked against the equations themselves, on every model,
+//! at random parameters and states.
 
-use dalembert::models::{BallWallEuler, Puck};
+use dalembert::for_each_model;
+use dalembert::models::*;
 use dalembert::runtime::Model;
-use dalembert::runtime::dynamics::{DynamicsError, accelerations};
+use dalembert::runtime::dynamics::{DynamicsError, accelerations, qdd};
+use dalembert::runtime::linalg::mat_vec;
+use nalgebra::DMatrix;
+use proptest::prelude::*;
+use proptest::test_runner::{Config, TestRunner};
 
 mod common;
-use common::{lcg, onto_kernel};
+use common::{lcg, onto_kernel, scaled};
 
 /// v projected onto ker A(q).
 fn admissible<M: Model<N, N>, const N: usize>(m: &M, q: &[f64; N], v: [f64; N]) -> [f64; N] {
@@ -84,4 +91,141 @@ fn singular_and_non_finite_states_are_typed_errors() {
         accelerations(&ball, &q, &[0.0; 5]),
         Err(DynamicsError::NonFinite)
     );
+}
+
+/// The closed form q̈ at (q, v) (v made admissible) solves the equations:
+/// r = G q̈ + h lies in the row space of A (r = Aᵀλ for some λ) and
+/// A q̈ + Ȧq̇ = 0. Both are checked with the generated G, h, A and Ȧq̇ only.
+fn check_closed_form<M: Model<Q, N>, const Q: usize, const N: usize>(
+    m: &M,
+    q: &[f64; Q],
+    v: [f64; N],
+) -> Result<(), TestCaseError> {
+    let a = m.constraints(q);
+    let v = onto_kernel(&a, v);
+    let Some(x) = m.closed_form_accelerations(q, &v) else {
+        return Err(TestCaseError::fail(format!("{}: no closed form", M::NAME)));
+    };
+    let h = m.forcing(q, &v);
+    let gx = mat_vec(&m.mass_matrix(q), &x);
+    let r: [f64; N] = std::array::from_fn(|i| gx[i] + h[i]);
+    let scale = 1.0 + h.iter().chain(&gx).fold(0.0_f64, |s, y| s.max(y.abs()));
+    // r minus its Euclidean projection onto the row space of A.
+    let k = a.len();
+    let rv = DMatrix::from_fn(N, 1, |i, _| r[i]);
+    let off = if k == 0 {
+        rv
+    } else {
+        let am = DMatrix::from_fn(k, N, |i, j| a.as_slice()[i][j]);
+        let lam = (&am * am.transpose()).lu().solve(&(&am * &rv)).unwrap();
+        rv - am.transpose() * lam
+    };
+    prop_assert!(
+        off.amax() <= 1e-9 * scale,
+        "{}: G q̈ + h off the row space of A by {}",
+        M::NAME,
+        off.amax()
+    );
+    let drift = m.constraint_drift(q, &v);
+    for (row, c) in a.as_slice().iter().zip(drift) {
+        let ax: f64 = row.iter().zip(&x).map(|(p, y)| p * y).sum();
+        prop_assert!(
+            (ax + c).abs() <= 1e-9 * scale,
+            "{}: A q̈ + Ȧq̇ = {}",
+            M::NAME,
+            ax + c
+        );
+    }
+    Ok(())
+}
+
+/// Random parameters (the file's values times [1/2, 2]), configurations in
+/// [0.2, 1.4] and velocities in [−3, 3], as in the invariant tests.
+fn closed_form<M: Model<Q, N>, const Q: usize, const N: usize>() {
+    let defaults = M::with_params(Default::default());
+    if Q == 0
+        || defaults
+            .closed_form_accelerations(&[0.5; Q], &[0.0; N])
+            .is_none()
+    {
+        // Instantaneous models have no motion; structured ones solve at run
+        // time (`closed_forms_exist_where_expected` says which are which).
+        return;
+    }
+    let np = M::PARAMETERS.len();
+    let strategy = (
+        proptest::collection::vec(0.5f64..2.0, np),
+        proptest::array::uniform::<_, Q>(0.2f64..1.4),
+        proptest::array::uniform::<_, N>(-3.0f64..3.0),
+    );
+    let mut runner = TestRunner::new(Config {
+        cases: 256,
+        ..Config::default()
+    });
+    runner
+        .run(&strategy, |(factors, q, v)| {
+            check_closed_form(&scaled::<M, Q, N>(&factors), &q, v)
+        })
+        .unwrap();
+}
+
+macro_rules! closed_form_test {
+    ($module:ident, $ty:ident, $q:literal, $n:literal) => {
+        #[test]
+        fn $module() {
+            closed_form::<$ty, $q, $n>();
+        }
+    };
+}
+
+mod closed_form_solves_the_equations {
+    use super::*;
+    for_each_model!(closed_form_test);
+}
+
+/// The generator derives q̈ in closed form wherever G⁻¹ is symbolic, and not
+/// for instantaneous models or structured chains.
+#[test]
+fn closed_forms_exist_where_expected() {
+    fn has<M: Model<Q, N> + Default, const Q: usize, const N: usize>() -> bool {
+        M::default()
+            .closed_form_accelerations(&[0.5; Q], &[0.0; N])
+            .is_some()
+    }
+    assert!(has::<BallBounce, 6, 6>());
+    assert!(has::<BallWallEuler, 5, 5>());
+    assert!(has::<PendulumWall, 2, 2>());
+    assert!(has::<Puck, 3, 3>());
+    assert!(has::<MassesOnLine, 2, 2>());
+    assert!(has::<Chain3, 3, 3>());
+    assert!(has::<Chain4Symbolic, 4, 4>());
+    assert!(!has::<Chain4, 4, 4>());
+    assert!(!has::<Chain8, 8, 8>());
+    assert!(!has::<BallWall, 0, 5>());
+}
+
+/// Where the closed form is not finite (G singular), `qdd` falls back to the
+/// numeric solve and reports why; elsewhere both agree.
+#[test]
+fn qdd_uses_the_closed_form_and_falls_back() {
+    let ball = BallWallEuler::default();
+    let q = [1.0, 0.0, 0.3, 0.0, 0.2];
+    assert!(ball.closed_form_accelerations(&q, &[0.0; 5]).is_some());
+    assert_eq!(
+        qdd(&ball, &q, &[0.0; 5]),
+        Err(DynamicsError::SingularMassMatrix)
+    );
+    let mut s = 11;
+    for _ in 0..100 {
+        let q: [f64; 5] = std::array::from_fn(|_| 0.2 + 1.2 * lcg(&mut s));
+        let v = admissible(&ball, &q, std::array::from_fn(|_| -2.0 + 4.0 * lcg(&mut s)));
+        let fast = qdd(&ball, &q, &v).unwrap();
+        let slow = accelerations(&ball, &q, &v).unwrap().qdd;
+        for (a, b) in fast.iter().zip(&slow) {
+            assert!(
+                (a - b).abs() < 1e-10 * (1.0 + b.abs()),
+                "{fast:?} vs {slow:?}"
+            );
+        }
+    }
 }

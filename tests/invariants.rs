@@ -12,7 +12,7 @@ use dalembert::runtime::linalg::{kinetic_energy, mat_mul, mat_vec, projector};
 use dalembert::runtime::{Model, Rows};
 
 mod common;
-use common::onto_kernel;
+use common::{onto_kernel, scaled};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 
@@ -160,12 +160,7 @@ fn run<M: Model<Q, N>, const Q: usize, const N: usize>() {
     );
     runner
         .run(&strategy, |(factors, q, v)| {
-            let mut model = M::with_params(Default::default());
-            for (i, f) in factors.iter().enumerate() {
-                let x = model.parameter(i).unwrap_or(1.0);
-                model.set_parameter(i, x * f);
-            }
-            check(&model, &q, v)
+            check(&scaled::<M, Q, N>(&factors), &q, v)
         })
         .unwrap();
 }

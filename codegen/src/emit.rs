@@ -228,6 +228,14 @@ fn inherent_impl(d: &Derivation) -> TokenStream {
         "Ȧq̇, one entry per row of A (the rest zero): A q̈ + Ȧq̇ = 0 along the motion.",
         &d.programs.constraint_drift,
     );
+    let accelerations = d.programs.accelerations.as_ref().map(|p| {
+        fn_vector(
+            d,
+            "accelerations",
+            "q̈ of the equations of motion G(q) q̈ + h(q, q̇) = A(q)ᵀλ, A(q) q̈ + Ȧq̇ = 0, in closed form (q̇ should satisfy A(q) q̇ = 0). Non-finite where G is singular.",
+            p,
+        )
+    });
     let walls = d.walls.iter().map(|w| wall_fns(d, w));
     let qn = Literal::usize_unsuffixed(q);
     let nn = Literal::usize_unsuffixed(n);
@@ -257,6 +265,7 @@ fn inherent_impl(d: &Derivation) -> TokenStream {
             #holonomic
             #forcing
             #drift
+            #accelerations
             #( #walls )*
         }
     }
@@ -640,6 +649,13 @@ fn trait_impl(d: &Derivation) -> TokenStream {
     let rows = per_wall("b_rows", quote! { q });
     let projector = per_wall("projector", quote! { q });
     let collide = per_wall("collide", quote! { q, v });
+    let accelerations = d.programs.accelerations.as_ref().map(|_| {
+        quote! {
+            fn closed_form_accelerations(&self, q: &[f64; #ql], v: &[f64; #nl]) -> Option<[f64; #nl]> {
+                Some(self.accelerations(q, v))
+            }
+        }
+    });
     quote! {
         impl ::dalembert_runtime::Model<#ql, #nl> for #ty {
             type Params = Params;
@@ -669,6 +685,7 @@ fn trait_impl(d: &Derivation) -> TokenStream {
             fn holonomic(&self, q: &[f64; #ql]) -> ::dalembert_runtime::Rows1<#nl> { self.holonomic(q) }
             fn forcing(&self, q: &[f64; #ql], v: &[f64; #nl]) -> [f64; #nl] { self.forcing(q, v) }
             fn constraint_drift(&self, q: &[f64; #ql], v: &[f64; #nl]) -> [f64; #nl] { self.constraint_drift(q, v) }
+            #accelerations
             fn surface(&self, wall: Wall, q: &[f64; #ql]) -> f64 { #surface }
             fn wall_rows(&self, wall: Wall, q: &[f64; #ql]) -> ::dalembert_runtime::Rows<#nl> { #rows }
             fn projector(&self, wall: Wall, q: &[f64; #ql]) -> [[f64; #nl]; #nl] { #projector }
@@ -740,6 +757,9 @@ pub fn op_counts(d: &Derivation) -> Vec<(String, OpCount)> {
             d.programs.constraint_drift.op_count(),
         ),
     ];
+    if let Some(p) = &d.programs.accelerations {
+        out.push(("accelerations".to_string(), p.op_count()));
+    }
     for w in &d.walls {
         out.push((format!("{}_surface", w.name), w.programs.surface.op_count()));
         out.push((format!("{}_b_rows", w.name), w.programs.rows.op_count()));

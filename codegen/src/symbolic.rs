@@ -38,6 +38,9 @@ pub struct Derivation {
     pub constraint_rows: Vec<Vec<String>>,
     /// The holonomic constraints h(q).
     pub holonomic: Vec<String>,
+    /// q̈ in closed form, component by component (see
+    /// [`Programs::accelerations`]).
+    pub accelerations: Option<Vec<String>>,
     /// Per wall.
     pub walls: Vec<WallDerivation>,
     /// Programs for the model-wide functions.
@@ -64,6 +67,10 @@ pub struct Programs {
     pub forcing: Program,
     /// Ȧq̇, one output per row of A (zero for instantaneous models).
     pub constraint_drift: Program,
+    /// q̈ of the equations of motion in closed form (n outputs), where G⁻¹
+    /// is derived exactly; `None` for an instantaneous model, a structured
+    /// G, or dependent rows of A (the run time then solves numerically).
+    pub accelerations: Option<Program>,
 }
 
 /// Programs for one wall.
@@ -243,9 +250,13 @@ impl<'a> Deriver<'a> {
             a_rows.push(self.linear_row(&e, &c.span)?);
         }
 
+        let (forcing, drift) = self.equations_of_motion(&t, &v_atom, &a_rows);
+
         // Lower function applications in everything the matrices use.
         let mut everything: Vec<Atom> = g.iter().flatten().cloned().collect();
         everything.extend(a_rows.iter().flatten().cloned());
+        everything.extend(forcing.iter().cloned());
+        everything.extend(drift.iter().cloned());
         let mut walls_raw = Vec::new();
         for w in &m.walls {
             let (surface, normal) = match m.kind {
@@ -410,8 +421,30 @@ impl<'a> Deriver<'a> {
             });
         }
 
-        let (forcing, drift) = self.equations_of_motion(&t, &v_atom, &a_rows);
+        let accelerations: Option<Vec<Atom>> = match (&g_inv, m.kind) {
+            (Some(g_inv), Kind::Coordinates) => {
+                let column = |d: &Self, e: &[Atom]| {
+                    let r: Vec<Rat> = e.iter().map(|a| to_rat(d, &(-a.clone()))).collect();
+                    Matrix::from_linear(r, e.len() as u32, 1, field.clone()).ok()
+                };
+                let neg_h = column(self, &forcing)?;
+                let constrained = match a_rat.is_empty() {
+                    true => None,
+                    false => Some((rows_matrix(&a_rat, n, &field)?, column(self, &drift)?)),
+                };
+                solve_motion(g_inv, constrained.as_ref(), &neg_h).map(|x| {
+                    (0..n)
+                        .map(|i| self.simplify(&x[(i as u32, 0)], &vars))
+                        .collect()
+                })
+            }
+            _ => None,
+        };
         let programs = Programs {
+            accelerations: match &accelerations {
+                Some(x) => Some(self.program(x, &inputs)?),
+                None => None,
+            },
             forcing: self.program(&forcing, &inputs)?,
             constraint_drift: self.program(&drift, &inputs)?,
             mass_matrix,
@@ -429,6 +462,9 @@ impl<'a> Deriver<'a> {
             mass_matrix: strings2(&g_simpl),
             constraint_rows: strings2(&a_rows),
             holonomic: holonomic.iter().map(|h| h.to_string()).collect(),
+            accelerations: accelerations
+                .as_deref()
+                .map(|x| x.iter().map(|a| a.to_string()).collect()),
             walls,
             programs,
         })
@@ -989,6 +1025,23 @@ fn projector(g_inv: &Matrix<Field>, b: &Matrix<Field>) -> Option<Matrix<Field>> 
     let m = b * &x;
     let m_inv = m.inv().ok()?;
     Some(&(&x * &m_inv) * b)
+}
+
+/// q̈ of G q̈ + h = Aᵀλ, A q̈ + Ȧq̇ = 0, from −h and (A, −Ȧq̇): with
+/// z = −G⁻¹h and Y = G⁻¹Aᵀ, (AY)λ = −Ȧq̇ − Az and q̈ = z + Yλ. `None` when
+/// AY is singular (dependent rows of A).
+fn solve_motion(
+    g_inv: &Matrix<Field>,
+    constraints: Option<&(Matrix<Field>, Matrix<Field>)>,
+    neg_h: &Matrix<Field>,
+) -> Option<Matrix<Field>> {
+    let z = g_inv * neg_h;
+    let Some((a, neg_c)) = constraints else {
+        return Some(z);
+    };
+    let y = g_inv * &a.transpose();
+    let lambda = &(a * &y).inv().ok()? * &(neg_c - &(a * &z));
+    Some(&z + &(&y * &lambda))
 }
 
 fn is_zero(a: &Atom) -> bool {

@@ -37,7 +37,23 @@ fn finite<const N: usize>(x: &[f64; N]) -> bool {
     x.iter().all(|v| v.is_finite())
 }
 
-/// q̈ and λ of model `m` at (q, q̇). `q̇` should satisfy A q̇ = 0.
+/// q̈ of model `m` at (q, q̇): the generated closed form
+/// ([`Model::closed_form_accelerations`]) where the model has one and it is
+/// finite there, else the numeric solve of [`accelerations`] (which also
+/// tells why a state has none). `q̇` should satisfy A q̇ = 0.
+pub fn qdd<M: Model<N, N>, const N: usize>(
+    m: &M,
+    q: &[f64; N],
+    qd: &[f64; N],
+) -> Result<[f64; N], DynamicsError> {
+    match m.closed_form_accelerations(q, qd) {
+        Some(x) if finite(&x) => Ok(x),
+        _ => accelerations(m, q, qd).map(|a| a.qdd),
+    }
+}
+
+/// q̈ and λ of model `m` at (q, q̇) by solving the equations numerically
+/// (Cholesky factorisations of G and A G⁻¹Aᵀ). `q̇` should satisfy A q̇ = 0.
 pub fn accelerations<M: Model<N, N>, const N: usize>(
     m: &M,
     q: &[f64; N],

@@ -160,6 +160,15 @@ pub trait Model<const Q: usize, const N: usize> {
     /// A q̈ + Ȧq̇ = 0.
     fn constraint_drift(&self, q: &[f64; Q], v: &[f64; N]) -> [f64; N];
 
+    /// q̈ of the equations of motion in closed form, where the generator
+    /// derived one (G⁻¹ exact); `None` (the default) means "solve
+    /// G q̈ + h = Aᵀλ numerically", as [`dynamics::accelerations`] does.
+    /// The result is non-finite where G is singular.
+    fn closed_form_accelerations(&self, q: &[f64; Q], v: &[f64; N]) -> Option<[f64; N]> {
+        let _ = (q, v);
+        None
+    }
+
     /// The wall's surface function f(q): motion in f ≥ 0, the wall is f = 0.
     /// Identically zero for an instantaneous model.
     fn surface(&self, wall: Self::Wall, q: &[f64; Q]) -> f64;

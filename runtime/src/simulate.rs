@@ -1,7 +1,7 @@
 //! The hybrid simulator: the paper's generalized solutions.
 //!
 //! Between collisions the state (q, q̇) follows the Lagrange–d'Alembert
-//! equations ([`crate::dynamics::accelerations`]), integrated by fixed-step
+//! equations ([`crate::dynamics::qdd`]: the generated closed form, or a numeric solve), integrated by fixed-step
 //! RK4 or by the adaptive Dormand–Prince 5(4) pair, both with dense output
 //! (cubic Hermite for RK4; Shampine's fourth-order continuous extension for
 //! Dormand–Prince, Hairer–Nørsett–Wanner, *Solving ODEs I*, §II.6). After
@@ -26,7 +26,7 @@
 //!
 //! No heap allocation; `#![no_std]`.
 
-use crate::dynamics::{DynamicsError, accelerations};
+use crate::dynamics::{DynamicsError, accelerations, qdd};
 use crate::linalg::{self, ProjectorError};
 use crate::{Model, libm};
 
@@ -477,6 +477,10 @@ impl<'m, M: Model<N, N>, const N: usize> Simulator<'m, M, N> {
                 departing |= 1 << k;
             }
         }
+        // The numeric solve checks that G (and A G⁻¹Aᵀ) is positive definite
+        // with these parameters, which a closed form used later does not.
+        accelerations(model, &start.q, &start.v)
+            .map_err(|error| SimError::Dynamics { t: start.t, error })?;
         let mut sim = Self {
             model,
             settings,
@@ -585,9 +589,8 @@ impl<'m, M: Model<N, N>, const N: usize> Simulator<'m, M, N> {
     /// (q̇, q̈) at y.
     fn rhs(&mut self, t: f64, y: &Y<N>) -> Result<Y<N>, SimError<M::Wall>> {
         self.stats.evaluations += 1;
-        let acc = accelerations(self.model, &y.q, &y.v)
-            .map_err(|error| SimError::Dynamics { t, error })?;
-        Ok(Y { q: y.v, v: acc.qdd })
+        let qdd = qdd(self.model, &y.q, &y.v).map_err(|error| SimError::Dynamics { t, error })?;
+        Ok(Y { q: y.v, v: qdd })
     }
 
     fn initial_step(&self) -> f64 {

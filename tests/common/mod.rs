@@ -2,7 +2,7 @@
 
 #![allow(dead_code)] // each test binary uses some of these
 
-use dalembert::runtime::Rows;
+use dalembert::runtime::{Model, Rows};
 use nalgebra::DMatrix;
 
 /// v projected onto ker A (Euclidean; membership in ker A does not depend on
@@ -29,4 +29,14 @@ pub fn lcg(state: &mut u64) -> f64 {
         .wrapping_mul(6364136223846793005)
         .wrapping_add(1442695040888963407);
     (*state >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// The model with each parameter the file's value times `factors[i]`.
+pub fn scaled<M: Model<Q, N>, const Q: usize, const N: usize>(factors: &[f64]) -> M {
+    let mut model = M::with_params(Default::default());
+    for (i, f) in factors.iter().enumerate() {
+        let x = model.parameter(i).unwrap_or(1.0);
+        model.set_parameter(i, x * f);
+    }
+    model
 }

@@ -21,6 +21,7 @@
 //   holonomic                    0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   forcing                      17 add, 42 mul, 0 div, 4 fn (63 in all)
 //   constraint_drift             4 add, 15 mul, 0 div, 4 fn (23 in all)
+//   accelerations                10 add, 30 mul, 2 div, 4 fn (46 in all)
 //   wall_surface                 1 add, 1 mul, 0 div, 0 fn (2 in all)
 //   wall_b_rows                  0 add, 7 mul, 0 div, 4 fn (11 in all)
 //   wall_projector               16 add, 47 mul, 2 div, 4 fn (69 in all)
@@ -328,6 +329,66 @@ impl BallWallEuler {
         let t6: f32 = i12 * t4;
         let o1: f32 = t3 + t6;
         [o0, o1, 0.0, 0.0, 0.0]
+    }
+    /// q̈ of the equations of motion G(q) q̈ + h(q, q̇) = A(q)ᵀλ, A(q) q̈ + Ȧq̇ = 0, in closed form (q̇ should satisfy A(q) q̇ = 0). Non-finite where G is singular.
+    #[inline]
+    #[allow(unused_variables)]
+    pub fn accelerations(&self, q: &[f32; 5], v: &[f32; 5]) -> [f32; 5] {
+        let i0: f32 = self.params.m;
+        let i1: f32 = self.params.r;
+        let i2: f32 = self.params.J;
+        let i4: f32 = self.params.a;
+        let i7: f32 = q[2];
+        let i8: f32 = q[3];
+        let i12: f32 = v[2];
+        let i13: f32 = v[3];
+        let i14: f32 = v[4];
+        let t0: f32 = i1 * i1;
+        let t0: f32 = i0 * t0;
+        let t1: f32 = i2 + t0;
+        let t1: f32 = 1.0 / (t1);
+        let t1: f32 = -(t1);
+        let o0: f32 = i4 * t0 * t1;
+        let o3: f32 = ::dalembert_runtime::libm::sinf(i8);
+        let t4: f32 = t0 * o3;
+        let t5: f32 = i2 * o3;
+        let t4: f32 = t4 + t5;
+        let t5: f32 = 1.0 / (t4);
+        let t4: f32 = ::dalembert_runtime::libm::cosf(i7);
+        let o4: f32 = ::dalembert_runtime::libm::cosf(i8);
+        let o4: f32 = -(o4);
+        let o2: f32 = i0 * i4;
+        let t4: f32 = i1 * t4;
+        let t4: f32 = o2 * t4;
+        let o2: f32 = o4 * t4;
+        let t8: f32 = i12 * o4;
+        let t8: f32 = i14 + t8;
+        let t9: f32 = t0 * t8;
+        let t8: f32 = i2 * t8;
+        let t8: f32 = t9 + t8;
+        let t9: f32 = i13 * t8;
+        let t8: f32 = o2 + t9;
+        let o2: f32 = t5 * t8;
+        let t9: f32 = i14 * o3;
+        let t8: f32 = i12 * t9;
+        let o3: f32 = i1 * t8;
+        let t9: f32 = ::dalembert_runtime::libm::sinf(i7);
+        let t9: f32 = i4 * t9;
+        let o3: f32 = o3 + t9;
+        let t9: f32 = i0 * i1 * o3;
+        let o3: f32 = i2 * t8;
+        let t8: f32 = t9 + o3;
+        let o3: f32 = t1 * t8;
+        let t9: f32 = i14 * o4;
+        let t1: f32 = i12 + t9;
+        let t8: f32 = t0 * t1;
+        let o4: f32 = i2 * t1;
+        let t9: f32 = t8 + o4;
+        let t0: f32 = i13 * t9;
+        let t1: f32 = t4 + t0;
+        let o4: f32 = t5 * t1;
+        let o1: f32 = 0f32;
+        [o0, o1, o2, o3, o4]
     }
     /// Wall `wall`: the surface function f(q).
     #[inline]
