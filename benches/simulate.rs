@@ -1,12 +1,16 @@
 //! Motion between collisions and the hybrid simulator, in one run:
 //!
-//! - `eom/<model>`: q̈ and λ at one state (`runtime::dynamics::accelerations`:
-//!   the generated G, h, A, Ȧq̇ and two fixed-size Cholesky solves);
+//! - `eom/<model>/closed_form`: q̈ at one state from the generated closed
+//!   form (`runtime::dynamics::qdd`, what the simulator calls), side by side
+//!   with `eom/<model>/numeric`: q̈ and λ by the runtime's numeric solve
+//!   (`runtime::dynamics::accelerations`: the generated G, h, A, Ȧq̇ and two
+//!   fixed-size Cholesky solves);
 //! - `step/<model>/<method>`: one accepted integrator step, projection and
 //!   crossing checks included;
-//! - `simulate/ball_bounce_100_bounces`: the §3.2.1 nonholonomic pendulum
-//!   from the model file's initial state through 100 bounces (throughput in
-//!   bounces per second);
+//! - `simulate/ball_bounce_{100,1000}_bounces`: the §3.2.1 nonholonomic
+//!   pendulum from the model file's initial state through 100 and 1000
+//!   bounces (throughput in bounces per second; the longer run takes more
+//!   steps per bounce, see docs/performance.md);
 //! - `simulate/rolling_ball_5s`: the §3.1 ball rolling under a uniform force
 //!   into the wall and back, 5 s of motion (throughput in steps per second).
 //!
@@ -15,9 +19,9 @@
 use std::hint::black_box;
 
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
-use dalembert::models::{BallBounce, BallWallEuler, PendulumWall, Puck};
+use dalembert::models::{BallBounce, BallWallEuler, Chain3, Chain8, PendulumWall, Puck};
 use dalembert::runtime::Model;
-use dalembert::runtime::dynamics::accelerations;
+use dalembert::runtime::dynamics::{accelerations, qdd};
 use dalembert::runtime::simulate::{Integrator, Settings, Simulator, State};
 
 fn initial<M: Model<N, N>, const N: usize>() -> State<N> {
@@ -31,7 +35,10 @@ fn initial<M: Model<N, N>, const N: usize>() -> State<N> {
 fn eom<M: Model<N, N> + Default, const N: usize>(c: &mut Criterion) {
     let m = M::default();
     let s = initial::<M, N>();
-    c.bench_function(&format!("eom/{}", M::NAME), |b| {
+    c.bench_function(&format!("eom/{}/closed_form", M::NAME), |b| {
+        b.iter(|| qdd(black_box(&m), black_box(&s.q), black_box(&s.v)).unwrap())
+    });
+    c.bench_function(&format!("eom/{}/numeric", M::NAME), |b| {
         b.iter(|| accelerations(black_box(&m), black_box(&s.q), black_box(&s.v)).unwrap())
     });
 }
@@ -60,18 +67,19 @@ fn simulate(c: &mut Criterion) {
     let ball = BallBounce::default();
     // §3.2.1 with the file's u = 2: a flight lasts 2u/g.
     let flight = 2.0 * 2.0 / ball.params.g;
-    let bounces = 100;
     let mut group = c.benchmark_group("simulate");
-    group.throughput(Throughput::Elements(bounces));
-    group.bench_function("ball_bounce_100_bounces", |b| {
-        b.iter(|| {
-            let mut sim =
-                Simulator::new(&ball, initial::<BallBounce, 6>(), Settings::default()).unwrap();
-            let stats = sim.run((bounces as f64 + 0.5) * flight, |_| true).unwrap();
-            assert_eq!(stats.collisions, bounces);
-            stats
-        })
-    });
+    for bounces in [100, 1000] {
+        group.throughput(Throughput::Elements(bounces));
+        group.bench_function(format!("ball_bounce_{bounces}_bounces"), |b| {
+            b.iter(|| {
+                let mut sim =
+                    Simulator::new(&ball, initial::<BallBounce, 6>(), Settings::default()).unwrap();
+                let stats = sim.run((bounces as f64 + 0.5) * flight, |_| true).unwrap();
+                assert_eq!(stats.collisions, bounces);
+                stats
+            })
+        });
+    }
     let rolling = BallWallEuler::default();
     let run = || {
         let mut sim =
@@ -88,6 +96,8 @@ fn all(c: &mut Criterion) {
     eom::<BallWallEuler, 5>(c);
     eom::<PendulumWall, 2>(c);
     eom::<Puck, 3>(c);
+    eom::<Chain3, 3>(c);
+    eom::<Chain8, 8>(c);
     step::<BallBounce, 6>(c);
     step::<BallWallEuler, 5>(c);
     step::<PendulumWall, 2>(c);

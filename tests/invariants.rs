@@ -4,7 +4,8 @@
 //! P² = P, GP = PᵀG, AP = A, BP = B (Lemma 1); the collision map keeps the
 //! kinetic energy (2.10), maps ker A into ker A, reverses the wall's normal
 //! velocity and is an involution; the generated P equals the one computed
-//! numerically from G and B by the runtime's generic path.
+//! numerically from G and B by the runtime's generic path; the emitted
+//! normal df and normal velocity agree with B's first row.
 
 use dalembert::for_each_model;
 use dalembert::models::*;
@@ -64,8 +65,27 @@ fn check<M: Model<Q, N>, const Q: usize, const N: usize>(
                 );
             }
         }
-        // AP = A and BP = B
+        // The emitted normal and normal velocity are B's first row and
+        // that row times v.
         let b = model.wall_rows(wall, q);
+        let row = b.as_slice()[0];
+        let normal = model.normal(wall, q);
+        let size = row.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        for j in 0..N {
+            prop_assert!(
+                close(normal[j], row[j], size),
+                "{} {name}: normal ≠ B's first row at {j}",
+                M::NAME
+            );
+        }
+        let nv: f64 = row.iter().zip(&v).map(|(x, y)| x * y).sum();
+        let vs = size * v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        prop_assert!(
+            close(model.normal_velocity(wall, q, &v), nv, vs),
+            "{} {name}: normal velocity ≠ B's first row · v",
+            M::NAME
+        );
+        // AP = A and BP = B
         for (what, rows) in [("A", &a), ("B", &b)] {
             for row in rows.as_slice() {
                 for j in 0..N {

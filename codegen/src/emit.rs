@@ -10,7 +10,9 @@ use quote::{format_ident, quote};
 
 use crate::Generated;
 use crate::ir::camel;
-use crate::program::{Instr, OpCount, Program, Slot};
+use std::collections::HashMap;
+
+use crate::program::{Func, Instr, OpCount, Program, Slot};
 use crate::symbolic::{Derivation, WallDerivation};
 
 /// The formatted Rust file for one model.
@@ -221,12 +223,14 @@ fn inherent_impl(d: &Derivation) -> TokenStream {
         "forcing",
         "h(q, q̇): the equations of motion are G(q) q̈ + h(q, q̇) = A(q)ᵀλ (zero for an instantaneous model).",
         &d.programs.forcing,
+        true,
     );
     let drift = fn_vector(
         d,
         "constraint_drift",
         "Ȧq̇, one entry per row of A (the rest zero): A q̈ + Ȧq̇ = 0 along the motion.",
         &d.programs.constraint_drift,
+        true,
     );
     let accelerations = d.programs.accelerations.as_ref().map(|p| {
         fn_vector(
@@ -234,6 +238,7 @@ fn inherent_impl(d: &Derivation) -> TokenStream {
             "accelerations",
             "q̈ of the equations of motion G(q) q̈ + h(q, q̇) = A(q)ᵀλ, A(q) q̈ + Ȧq̇ = 0, in closed form (q̇ should satisfy A(q) q̇ = 0). Non-finite where G is singular.",
             p,
+            true,
         )
     });
     let walls = d.walls.iter().map(|w| wall_fns(d, w));
@@ -281,6 +286,20 @@ fn wall_fns(d: &Derivation, w: &WallDerivation) -> TokenStream {
         &w.programs.surface,
         false,
     );
+    let normal_row = fn_vector(
+        d,
+        &format!("{name}_normal"),
+        &format!("Wall `{name}`: its normal df(q), the first row of B."),
+        &w.programs.normal,
+        false,
+    );
+    let normal = fn_scalar(
+        d,
+        &format!("{name}_normal_velocity"),
+        &format!("Wall `{name}`: the normal velocity df(q)·v, negative while approaching."),
+        &w.programs.normal_velocity,
+        true,
+    );
     let rows = fn_rows(
         d,
         &format!("{name}_b_rows"),
@@ -290,7 +309,7 @@ fn wall_fns(d: &Derivation, w: &WallDerivation) -> TokenStream {
     );
     if w.structured {
         let structured = structured_fns(d, w);
-        return quote! { #surface #rows #structured };
+        return quote! { #surface #normal_row #normal #rows #structured };
     }
     let projector = fn_matrix(
         d,
@@ -304,8 +323,9 @@ fn wall_fns(d: &Derivation, w: &WallDerivation) -> TokenStream {
         &format!("{name}_collide"),
         &format!("Wall `{name}`: the collision map v⁺ = (I − 2P)v⁻."),
         &w.programs.collide,
+        true,
     );
-    quote! { #surface #rows #projector #collide }
+    quote! { #surface #normal_row #normal #rows #projector #collide }
 }
 
 /// P and the collision map of a wall evaluated at run time from the
@@ -387,7 +407,7 @@ fn fn_scalar(d: &Derivation, name: &str, doc: &str, p: &Program, with_v: bool) -
 
 /// A function of (q, v) returning an n-vector: the program's outputs, padded
 /// with zeros when it has fewer than n.
-fn fn_vector(d: &Derivation, name: &str, doc: &str, p: &Program) -> TokenStream {
+fn fn_vector(d: &Derivation, name: &str, doc: &str, p: &Program, with_v: bool) -> TokenStream {
     let n = d.model.velocities.len();
     let outs = padded_outputs(p, n);
     let nl = Literal::usize_unsuffixed(n);
@@ -396,7 +416,7 @@ fn fn_vector(d: &Derivation, name: &str, doc: &str, p: &Program) -> TokenStream 
         name,
         doc,
         p,
-        true,
+        with_v,
         {
             let real = real(d);
             quote! { [#real; #nl] }
@@ -512,8 +532,75 @@ fn body(d: &Derivation, p: &Program) -> TokenStream {
         let real = real(d);
         quote! { let #name: #real = #value; }
     });
-    let stmts = p.instrs.iter().map(|ins| instr(d, p, ins));
+    let pairs = sincos_pairs(p);
+    let stmts = p
+        .instrs
+        .iter()
+        .zip(&pairs)
+        .map(|(ins, pair)| match (ins, pair) {
+            (Instr::Fun(dst, f, src), Some(pair)) => sincos(d, p, *dst, *f, *src, *pair),
+            _ => instr(d, p, ins),
+        });
     quote! { #(#inputs)* #(#stmts)* }
+}
+
+/// sin and cos of the same value, to be computed together by `sincos` (one
+/// argument reduction instead of two): for each instruction, the number of
+/// its pair and whether it comes first. Slots may be reassigned, so a value
+/// is a slot together with how many times it has been written before.
+fn sincos_pairs(p: &Program) -> Vec<Option<(usize, bool)>> {
+    let mut writes: HashMap<Slot, usize> = HashMap::new();
+    // (source value) → (index of its sin, index of its cos)
+    let mut calls: HashMap<(Slot, usize), (Option<usize>, Option<usize>)> = HashMap::new();
+    for (i, ins) in p.instrs.iter().enumerate() {
+        let dst = match ins {
+            Instr::Add(o, _) | Instr::Mul(o, _) | Instr::Pow(o, _, _) | Instr::Assign(o, _) => *o,
+            Instr::Fun(o, f, src) => {
+                let value = (*src, writes.get(src).copied().unwrap_or(0));
+                let entry = calls.entry(value).or_default();
+                match f {
+                    Func::Sin if entry.0.is_none() => entry.0 = Some(i),
+                    Func::Cos if entry.1.is_none() => entry.1 = Some(i),
+                    _ => {}
+                }
+                *o
+            }
+        };
+        *writes.entry(dst).or_default() += 1;
+    }
+    let mut found: Vec<(usize, usize)> = calls
+        .into_values()
+        .filter_map(|(s, c)| Some((s?, c?)))
+        .collect();
+    found.sort_unstable_by_key(|&(s, c)| s.min(c));
+    let mut out = vec![None; p.instrs.len()];
+    for (k, (s, c)) in found.into_iter().enumerate() {
+        out[s] = Some((k, s < c));
+        out[c] = Some((k, c < s));
+    }
+    out
+}
+
+/// One half of a sin/cos pair: the first computes both into `sc{k}_sin`
+/// and `sc{k}_cos`, each takes its own.
+fn sincos(
+    d: &Derivation,
+    p: &Program,
+    dst: Slot,
+    f: Func,
+    src: Slot,
+    (k, first): (usize, bool),
+) -> TokenStream {
+    let (s, c) = (format_ident!("sc{k}_sin"), format_ident!("sc{k}_cos"));
+    let real = real(d);
+    let both = first.then(|| {
+        let call = libm_fn(d, "sincos");
+        let src = slot(d, p, src);
+        quote! { let (#s, #c): (#real, #real) = #call(#src); }
+    });
+    let mine = if f == Func::Sin { s } else { c };
+    let dst = slot(d, p, dst);
+    quote! { #both let #dst: #real = #mine; }
 }
 
 fn sources(ins: &Instr) -> Vec<Slot> {
@@ -649,8 +736,11 @@ fn trait_impl(d: &Derivation) -> TokenStream {
     let rows = per_wall("b_rows", quote! { q });
     let projector = per_wall("projector", quote! { q });
     let collide = per_wall("collide", quote! { q, v });
+    let normal = per_wall("normal_velocity", quote! { q, v });
+    let normal_row = per_wall("normal", quote! { q });
     let accelerations = d.programs.accelerations.as_ref().map(|_| {
         quote! {
+            #[inline]
             fn closed_form_accelerations(&self, q: &[f64; #ql], v: &[f64; #nl]) -> Option<[f64; #nl]> {
                 Some(self.accelerations(q, v))
             }
@@ -678,18 +768,33 @@ fn trait_impl(d: &Derivation) -> TokenStream {
             fn wall_name(wall: Wall) -> &'static str {
                 match wall { #(Wall::#variants => #wall_names,)* }
             }
+            #[inline]
             fn mass_matrix(&self, q: &[f64; #ql]) -> [[f64; #nl]; #nl] { self.mass_matrix(q) }
+            #[inline]
             fn kinetic_energy(&self, q: &[f64; #ql], v: &[f64; #nl]) -> f64 { self.kinetic_energy(q, v) }
+            #[inline]
             fn potential(&self, q: &[f64; #ql]) -> f64 { self.potential(q) }
+            #[inline]
             fn constraints(&self, q: &[f64; #ql]) -> ::dalembert_runtime::Rows<#nl> { self.constraints(q) }
+            #[inline]
             fn holonomic(&self, q: &[f64; #ql]) -> ::dalembert_runtime::Rows1<#nl> { self.holonomic(q) }
+            #[inline]
             fn forcing(&self, q: &[f64; #ql], v: &[f64; #nl]) -> [f64; #nl] { self.forcing(q, v) }
+            #[inline]
             fn constraint_drift(&self, q: &[f64; #ql], v: &[f64; #nl]) -> [f64; #nl] { self.constraint_drift(q, v) }
             #accelerations
+            #[inline]
             fn surface(&self, wall: Wall, q: &[f64; #ql]) -> f64 { #surface }
+            #[inline]
             fn wall_rows(&self, wall: Wall, q: &[f64; #ql]) -> ::dalembert_runtime::Rows<#nl> { #rows }
+            #[inline]
             fn projector(&self, wall: Wall, q: &[f64; #ql]) -> [[f64; #nl]; #nl] { #projector }
+            #[inline]
             fn collide(&self, wall: Wall, q: &[f64; #ql], v: &[f64; #nl]) -> [f64; #nl] { #collide }
+            #[inline]
+            fn normal(&self, wall: Wall, q: &[f64; #ql]) -> [f64; #nl] { #normal_row }
+            #[inline]
+            fn normal_velocity(&self, wall: Wall, q: &[f64; #ql], v: &[f64; #nl]) -> f64 { #normal }
         }
     }
 }
@@ -762,6 +867,11 @@ pub fn op_counts(d: &Derivation) -> Vec<(String, OpCount)> {
     }
     for w in &d.walls {
         out.push((format!("{}_surface", w.name), w.programs.surface.op_count()));
+        out.push((format!("{}_normal", w.name), w.programs.normal.op_count()));
+        out.push((
+            format!("{}_normal_velocity", w.name),
+            w.programs.normal_velocity.op_count(),
+        ));
         out.push((format!("{}_b_rows", w.name), w.programs.rows.op_count()));
         if w.structured {
             continue;

@@ -6,7 +6,7 @@
 //! on the symbolic engine, so the emitter and tests can use it freely.
 
 /// Where a value lives.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Slot {
     /// The i-th input.
     Input(usize),

@@ -80,6 +80,10 @@ pub struct WallPrograms {
     pub surface: Program,
     /// B (rows·n outputs).
     pub rows: Program,
+    /// The wall's normal df(q) (B's first row; n outputs).
+    pub normal: Program,
+    /// The normal velocity df·v.
+    pub normal_velocity: Program,
     /// P (n² outputs).
     pub projector: Program,
     /// (I − 2P)v (n outputs).
@@ -257,6 +261,7 @@ impl<'a> Deriver<'a> {
         everything.extend(a_rows.iter().flatten().cloned());
         everything.extend(forcing.iter().cloned());
         everything.extend(drift.iter().cloned());
+        everything.extend([t.clone(), v_atom.clone()]);
         let mut walls_raw = Vec::new();
         for w in &m.walls {
             let (surface, normal) = match m.kind {
@@ -395,8 +400,15 @@ impl<'a> Deriver<'a> {
                 }
                 None => (Vec::new(), Vec::new()),
             };
+            let normal: Vec<Atom> = normal.iter().map(|a| self.reduce_atom(a, &vars)).collect();
+            let mut normal_velocity = Atom::num(0);
+            for (k, row) in normal.iter().enumerate() {
+                normal_velocity += row.clone() * Atom::from(self.vels[k]);
+            }
             let programs = WallPrograms {
                 surface: self.program(std::slice::from_ref(&surface), &inputs)?,
+                normal: self.program(&normal, &inputs)?,
+                normal_velocity: self.program(std::slice::from_ref(&normal_velocity), &inputs)?,
                 rows: self.program(
                     &b_atoms.iter().flatten().cloned().collect::<Vec<_>>(),
                     &inputs,
@@ -448,8 +460,8 @@ impl<'a> Deriver<'a> {
             forcing: self.program(&forcing, &inputs)?,
             constraint_drift: self.program(&drift, &inputs)?,
             mass_matrix,
-            kinetic_energy: self.program(std::slice::from_ref(&t), &inputs)?,
-            potential: self.program(std::slice::from_ref(&v_atom), &inputs)?,
+            kinetic_energy: self.program(&[self.reduce_atom(&t, &vars)], &inputs)?,
+            potential: self.program(&[self.reduce_atom(&v_atom, &vars)], &inputs)?,
             constraints: self.program(
                 &a_rows.iter().flatten().cloned().collect::<Vec<_>>(),
                 &inputs,

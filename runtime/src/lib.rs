@@ -185,7 +185,18 @@ pub trait Model<const Q: usize, const N: usize> {
         self.kinetic_energy(q, v) + self.potential(q)
     }
 
+    /// The wall's normal df(q) (the first row of B). Generated models emit
+    /// it directly; the default takes B's first row.
+    fn normal(&self, wall: Self::Wall, q: &[f64; Q]) -> [f64; N] {
+        self.wall_rows(wall, q)
+            .as_slice()
+            .first()
+            .copied()
+            .unwrap_or([0.0; N])
+    }
+
     /// Normal velocity df(q)·v at the wall: negative while approaching it.
+    /// (Generated models emit it directly; the default takes B's first row.)
     fn normal_velocity(&self, wall: Self::Wall, q: &[f64; Q], v: &[f64; N]) -> f64 {
         match self.wall_rows(wall, q).as_slice().first() {
             Some(row) => linalg::dot(row, v),

@@ -288,12 +288,12 @@ impl<const N: usize> Y<N> {
     fn plus(&self, h: f64, terms: &[(f64, &Y<N>)]) -> Self {
         let mut out = *self;
         for &(c, d) in terms {
-            if c == 0.0 {
-                continue;
+            let hc = h * c;
+            for (o, x) in out.q.iter_mut().zip(&d.q) {
+                *o += hc * x;
             }
-            for i in 0..N {
-                out.q[i] += h * c * d.q[i];
-                out.v[i] += h * c * d.v[i];
+            for (o, x) in out.v.iter_mut().zip(&d.v) {
+                *o += hc * x;
             }
         }
         out
@@ -319,37 +319,44 @@ enum Dense<const N: usize> {
 }
 
 impl<const N: usize> Dense<N> {
-    /// The interpolated state at θ ∈ [0, 1] of a step of length `h`.
-    fn at(&self, theta: f64, h: f64) -> Y<N> {
-        let s = 1.0 - theta;
+    /// One half of the interpolated state at θ ∈ [0, 1] of a step of length
+    /// `h`: `part` picks q or v out of each stored (q, v) pair.
+    fn interpolate(&self, theta: f64, h: f64, part: fn(&Y<N>) -> &[f64; N]) -> [f64; N] {
         match self {
             Dense::Hermite { y0, y1, f0, f1 } => {
                 // y₀ + θ(y₁−y₀) + θ(θ−1)[(1−2θ)(y₁−y₀) + (θ−1)h f₀ + θ h f₁]
-                let mut out = Y::ZERO;
                 let c = theta * (theta - 1.0);
-                for i in 0..N {
-                    let hermite = |a: f64, b: f64, fa: f64, fb: f64| {
-                        let d = b - a;
-                        a + theta * d
-                            + c * ((1.0 - 2.0 * theta) * d
-                                + (theta - 1.0) * h * fa
-                                + theta * h * fb)
-                    };
-                    out.q[i] = hermite(y0.q[i], y1.q[i], f0.q[i], f1.q[i]);
-                    out.v[i] = hermite(y0.v[i], y1.v[i], f0.v[i], f1.v[i]);
-                }
-                out
+                let (a, b, fa, fb) = (part(y0), part(y1), part(f0), part(f1));
+                core::array::from_fn(|i| {
+                    let d = b[i] - a[i];
+                    a[i] + theta * d
+                        + c * ((1.0 - 2.0 * theta) * d
+                            + (theta - 1.0) * h * fa[i]
+                            + theta * h * fb[i])
+                })
             }
             Dense::Shampine { y0, r } => {
-                let mut out = Y::ZERO;
-                for i in 0..N {
-                    let poly =
-                        |x: [f64; 4]| theta * (x[0] + s * (x[1] + theta * (x[2] + s * x[3])));
-                    out.q[i] = y0.q[i] + poly([r[0].q[i], r[1].q[i], r[2].q[i], r[3].q[i]]);
-                    out.v[i] = y0.v[i] + poly([r[0].v[i], r[1].v[i], r[2].v[i], r[3].v[i]]);
-                }
-                out
+                // y₀ + θ(r₁ + (1−θ)(r₂ + θ(r₃ + (1−θ)r₄)))
+                let s = 1.0 - theta;
+                let (a, r) = (part(y0), r.each_ref().map(part));
+                core::array::from_fn(|i| {
+                    a[i] + theta * (r[0][i] + s * (r[1][i] + theta * (r[2][i] + s * r[3][i])))
+                })
             }
+        }
+    }
+
+    /// The interpolated coordinates alone (half the work of [`Dense::at`];
+    /// a wall's f needs no more).
+    fn position(&self, theta: f64, h: f64) -> [f64; N] {
+        self.interpolate(theta, h, |y| &y.q)
+    }
+
+    /// The interpolated state at θ ∈ [0, 1] of a step of length `h`.
+    fn at(&self, theta: f64, h: f64) -> Y<N> {
+        Y {
+            q: self.interpolate(theta, h, |y| &y.q),
+            v: self.interpolate(theta, h, |y| &y.v),
         }
     }
 }
@@ -619,23 +626,63 @@ impl<'m, M: Model<N, N>, const N: usize> Simulator<'m, M, N> {
         }
     }
 
-    /// One step of length `h` from (t0, y0) without error control.
-    fn trial(&mut self, y0: &Y<N>, t0: f64, h: f64) -> Result<Trial<N>, SimError<M::Wall>> {
-        let f0 = self.f0;
+    /// The stages of one step of length `h` from (t0, y0) and the step's
+    /// end y₁: RK4's k₁…k₄ (k₁ = f₀, the rest zero), or Dormand–Prince's
+    /// seven (the last is f(y₁), FSAL).
+    fn stages(
+        &mut self,
+        y0: &Y<N>,
+        t0: f64,
+        h: f64,
+        k: &mut [Y<N>; 7],
+    ) -> Result<Y<N>, SimError<M::Wall>> {
+        k[0] = self.f0;
         match self.settings.integrator {
             Integrator::Rk4 { .. } => {
-                let k2 = self.rhs(t0 + h / 2.0, &y0.plus(h, &[(0.5, &f0)]))?;
-                let k3 = self.rhs(t0 + h / 2.0, &y0.plus(h, &[(0.5, &k2)]))?;
-                let k4 = self.rhs(t0 + h, &y0.plus(h, &[(1.0, &k3)]))?;
-                let y1 = y0.plus(
-                    h,
-                    &[
-                        (1.0 / 6.0, &f0),
-                        (1.0 / 3.0, &k2),
-                        (1.0 / 3.0, &k3),
-                        (1.0 / 6.0, &k4),
-                    ],
-                );
+                k[1] = self.rhs(t0 + h / 2.0, &y0.plus(h, &[(0.5, &k[0])]))?;
+                k[2] = self.rhs(t0 + h / 2.0, &y0.plus(h, &[(0.5, &k[1])]))?;
+                k[3] = self.rhs(t0 + h, &y0.plus(h, &[(1.0, &k[2])]))?;
+                let weights = [1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
+                let terms: [(f64, &Y<N>); 4] = core::array::from_fn(|j| (weights[j], &k[j]));
+                Ok(y0.plus(h, &terms))
+            }
+            Integrator::DormandPrince { .. } => {
+                for s in 1..7 {
+                    let terms: [(f64, &Y<N>); 6] = core::array::from_fn(|j| (A[s][j], &k[j]));
+                    let ys = y0.plus(h, &terms[..s]);
+                    k[s] = self.rhs(t0 + C[s] * h, &ys)?;
+                }
+                // The last stage was evaluated at y₁ itself.
+                let terms: [(f64, &Y<N>); 6] = core::array::from_fn(|j| (A[6][j], &k[j]));
+                Ok(y0.plus(h, &terms))
+            }
+        }
+    }
+
+    /// The end of one step of length `h` from (t0, y0), and f there when the
+    /// method has it for free (Dormand–Prince); no error estimate, no dense
+    /// output.
+    fn advance(
+        &mut self,
+        y0: &Y<N>,
+        t0: f64,
+        h: f64,
+    ) -> Result<(Y<N>, Option<Y<N>>), SimError<M::Wall>> {
+        let mut k = [Y::ZERO; 7];
+        let y1 = self.stages(y0, t0, h, &mut k)?;
+        let f1 = match self.settings.integrator {
+            Integrator::Rk4 { .. } => None,
+            Integrator::DormandPrince { .. } => Some(k[6]),
+        };
+        Ok((y1, f1))
+    }
+
+    /// One step of length `h` from (t0, y0) without error control.
+    fn trial(&mut self, y0: &Y<N>, t0: f64, h: f64) -> Result<Trial<N>, SimError<M::Wall>> {
+        let mut k = [Y::ZERO; 7];
+        let y1 = self.stages(y0, t0, h, &mut k)?;
+        match self.settings.integrator {
+            Integrator::Rk4 { .. } => {
                 let f1 = self.rhs(t0 + h, &y1)?;
                 Ok(Trial {
                     y1,
@@ -644,21 +691,12 @@ impl<'m, M: Model<N, N>, const N: usize> Simulator<'m, M, N> {
                     dense: Dense::Hermite {
                         y0: *y0,
                         y1,
-                        f0,
+                        f0: k[0],
                         f1,
                     },
                 })
             }
             Integrator::DormandPrince { rtol, atol, .. } => {
-                let mut k = [Y::ZERO; 7];
-                k[0] = f0;
-                for s in 1..7 {
-                    let terms: [(f64, &Y<N>); 6] = core::array::from_fn(|j| (A[s][j], &k[j]));
-                    let ys = y0.plus(h, &terms[..s]);
-                    k[s] = self.rhs(t0 + C[s] * h, &ys)?;
-                }
-                let terms: [(f64, &Y<N>); 6] = core::array::from_fn(|j| (A[6][j], &k[j]));
-                let y1 = y0.plus(h, &terms);
                 let e_terms: [(f64, &Y<N>); 7] = core::array::from_fn(|j| (E[j], &k[j]));
                 let err = Y::ZERO.plus(h, &e_terms);
                 let error = scaled_norm(&err, y0, &y1, rtol, atol);
@@ -714,10 +752,13 @@ impl<'m, M: Model<N, N>, const N: usize> Simulator<'m, M, N> {
             let err = trial.error;
             // Standard controller: safety 0.9, exponent 1/5, factor in
             // [0.2, 5] (at most 1 right after a rejection).
-            let fac = if err == 0.0 {
+            // 0.9·err^(−1/5) reaches 5 for err ≤ (0.9/5)⁵ and 0.2 for
+            // err ≥ 4.5⁵: the power (by exp and log, faster than pow) is
+            // needed only in between.
+            let fac = if err <= 1.889568e-4 {
                 5.0
-            } else if err.is_finite() {
-                (0.9 * libm::pow(err, -0.2)).clamp(0.2, 5.0)
+            } else if err < 1845.28125 {
+                (0.9 * libm::exp(-0.2 * libm::log(err))).clamp(0.2, 5.0)
             } else {
                 0.2
             };
@@ -800,7 +841,16 @@ impl<'m, M: Model<N, N>, const N: usize> Simulator<'m, M, N> {
                 trial.dense.at(theta, h)
             }
         };
-        let f = |theta: f64| m.surface(wall, &state(theta).q);
+        let f = |theta: f64| {
+            let q = if theta == 0.0 {
+                y0.q
+            } else if theta == 1.0 {
+                trial.y1.q
+            } else {
+                trial.dense.position(theta, h)
+            };
+            m.surface(wall, &q)
+        };
         let rate = |theta: f64| {
             let y = state(theta);
             m.normal_velocity(wall, &y.q, &y.v)
@@ -871,7 +921,7 @@ impl<'m, M: Model<N, N>, const N: usize> Simulator<'m, M, N> {
     ) -> Result<Collision<M::Wall, N>, SimError<M::Wall>> {
         let m = self.model;
         let wall = M::WALLS[k];
-        let mut y = self.trial(y0, t0, tc - t0)?.y1;
+        let (mut y, mut fy) = self.advance(y0, t0, tc - t0)?;
         for _ in 0..6 {
             let f = m.surface(wall, &y.q);
             let nv = m.normal_velocity(wall, &y.q, &y.v);
@@ -883,25 +933,29 @@ impl<'m, M: Model<N, N>, const N: usize> Simulator<'m, M, N> {
                 break;
             }
             let delta = next - tc;
-            let candidate = if delta.abs() <= 1e-6 * (t1 - t0) {
-                // A tiny correction: second-order Taylor from y (one
+            let (candidate, f_candidate) = if delta.abs() <= 1e-6 * (t1 - t0) {
+                // A tiny correction: second-order Taylor from y (at most one
                 // evaluation instead of a step; the error is O(δ³)).
-                let d = self.rhs(tc, &y)?;
-                Y {
+                let d = match fy {
+                    Some(d) => d,
+                    None => self.rhs(tc, &y)?,
+                };
+                let taylor = Y {
                     q: core::array::from_fn(|i| y.q[i] + delta * (y.v[i] + 0.5 * delta * d.v[i])),
                     v: core::array::from_fn(|i| y.v[i] + delta * d.v[i]),
-                }
+                };
+                (taylor, None)
             } else {
-                self.trial(y0, t0, next - t0)?.y1
+                self.advance(y0, t0, next - t0)?
             };
             if m.surface(wall, &candidate.q).abs() >= f.abs() {
                 break;
             }
             tc = next;
             y = candidate;
+            fy = f_candidate;
         }
-        let rows = m.wall_rows(wall, &y.q);
-        let normal = rows.as_slice().first().map_or(0.0, |r| norm(r));
+        let normal = norm(&m.normal(wall, &y.q));
         let nv = m.normal_velocity(wall, &y.q, &y.v);
         if -nv <= self.settings.grazing * normal * norm(&y.v) {
             return Err(SimError::Grazing {

@@ -15,6 +15,8 @@
 //   forcing                      0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   constraint_drift             0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_surface                0 add, 0 mul, 0 div, 0 fn (0 in all)
+//   floor_normal                 0 add, 0 mul, 0 div, 0 fn (0 in all)
+//   floor_normal_velocity        0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_b_rows                 0 add, 1 mul, 0 div, 0 fn (1 in all)
 //   floor_projector              1 add, 10 mul, 1 div, 0 fn (12 in all)
 //   floor_collide                8 add, 19 mul, 1 div, 0 fn (28 in all)
@@ -201,6 +203,26 @@ impl BallFloor {
         let o0: f64 = 0f64;
         o0
     }
+    /// Wall `floor`: its normal df(q), the first row of B.
+    #[inline]
+    #[allow(unused_variables)]
+    pub fn floor_normal(&self, q: &[f64; 0]) -> [f64; 6] {
+        let o0: f64 = 0f64;
+        let o1: f64 = 0f64;
+        let o2: f64 = 1f64;
+        let o3: f64 = 0f64;
+        let o4: f64 = 0f64;
+        let o5: f64 = 0f64;
+        [o0, o1, o2, o3, o4, o5]
+    }
+    /// Wall `floor`: the normal velocity df(q)·v, negative while approaching.
+    #[inline]
+    #[allow(unused_variables)]
+    pub fn floor_normal_velocity(&self, q: &[f64; 0], v: &[f64; 6]) -> f64 {
+        let i5: f64 = v[2];
+        let o0: f64 = i5;
+        o0
+    }
     /// Wall `floor`: the independent rows of B(q), the normal velocity first.
     #[inline]
     #[allow(unused_variables)]
@@ -383,45 +405,68 @@ impl ::dalembert_runtime::Model<0, 6> for BallFloor {
             Wall::Floor => "floor",
         }
     }
+    #[inline]
     fn mass_matrix(&self, q: &[f64; 0]) -> [[f64; 6]; 6] {
         self.mass_matrix(q)
     }
+    #[inline]
     fn kinetic_energy(&self, q: &[f64; 0], v: &[f64; 6]) -> f64 {
         self.kinetic_energy(q, v)
     }
+    #[inline]
     fn potential(&self, q: &[f64; 0]) -> f64 {
         self.potential(q)
     }
+    #[inline]
     fn constraints(&self, q: &[f64; 0]) -> ::dalembert_runtime::Rows<6> {
         self.constraints(q)
     }
+    #[inline]
     fn holonomic(&self, q: &[f64; 0]) -> ::dalembert_runtime::Rows1<6> {
         self.holonomic(q)
     }
+    #[inline]
     fn forcing(&self, q: &[f64; 0], v: &[f64; 6]) -> [f64; 6] {
         self.forcing(q, v)
     }
+    #[inline]
     fn constraint_drift(&self, q: &[f64; 0], v: &[f64; 6]) -> [f64; 6] {
         self.constraint_drift(q, v)
     }
+    #[inline]
     fn surface(&self, wall: Wall, q: &[f64; 0]) -> f64 {
         match wall {
             Wall::Floor => self.floor_surface(q),
         }
     }
+    #[inline]
     fn wall_rows(&self, wall: Wall, q: &[f64; 0]) -> ::dalembert_runtime::Rows<6> {
         match wall {
             Wall::Floor => self.floor_b_rows(q),
         }
     }
+    #[inline]
     fn projector(&self, wall: Wall, q: &[f64; 0]) -> [[f64; 6]; 6] {
         match wall {
             Wall::Floor => self.floor_projector(q),
         }
     }
+    #[inline]
     fn collide(&self, wall: Wall, q: &[f64; 0], v: &[f64; 6]) -> [f64; 6] {
         match wall {
             Wall::Floor => self.floor_collide(q, v),
+        }
+    }
+    #[inline]
+    fn normal(&self, wall: Wall, q: &[f64; 0]) -> [f64; 6] {
+        match wall {
+            Wall::Floor => self.floor_normal(q),
+        }
+    }
+    #[inline]
+    fn normal_velocity(&self, wall: Wall, q: &[f64; 0], v: &[f64; 6]) -> f64 {
+        match wall {
+            Wall::Floor => self.floor_normal_velocity(q, v),
         }
     }
 }

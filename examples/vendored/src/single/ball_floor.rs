@@ -15,6 +15,8 @@
 //   forcing                      0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   constraint_drift             0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_surface                0 add, 0 mul, 0 div, 0 fn (0 in all)
+//   floor_normal                 0 add, 0 mul, 0 div, 0 fn (0 in all)
+//   floor_normal_velocity        0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_b_rows                 0 add, 1 mul, 0 div, 0 fn (1 in all)
 //   floor_projector              1 add, 10 mul, 1 div, 0 fn (12 in all)
 //   floor_collide                8 add, 19 mul, 1 div, 0 fn (28 in all)
@@ -199,6 +201,26 @@ impl BallFloor {
     #[allow(unused_variables)]
     pub fn floor_surface(&self, q: &[f32; 0]) -> f32 {
         let o0: f32 = 0f32;
+        o0
+    }
+    /// Wall `floor`: its normal df(q), the first row of B.
+    #[inline]
+    #[allow(unused_variables)]
+    pub fn floor_normal(&self, q: &[f32; 0]) -> [f32; 6] {
+        let o0: f32 = 0f32;
+        let o1: f32 = 0f32;
+        let o2: f32 = 1f32;
+        let o3: f32 = 0f32;
+        let o4: f32 = 0f32;
+        let o5: f32 = 0f32;
+        [o0, o1, o2, o3, o4, o5]
+    }
+    /// Wall `floor`: the normal velocity df(q)·v, negative while approaching.
+    #[inline]
+    #[allow(unused_variables)]
+    pub fn floor_normal_velocity(&self, q: &[f32; 0], v: &[f32; 6]) -> f32 {
+        let i5: f32 = v[2];
+        let o0: f32 = i5;
         o0
     }
     /// Wall `floor`: the independent rows of B(q), the normal velocity first.

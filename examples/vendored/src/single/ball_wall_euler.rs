@@ -15,7 +15,7 @@
 //
 // Operation counts (f32):
 //   mass_matrix                  0 add, 1 mul, 0 div, 1 fn (2 in all)
-//   kinetic_energy               7 add, 15 mul, 0 div, 4 fn (26 in all)
+//   kinetic_energy               5 add, 10 mul, 0 div, 1 fn (16 in all)
 //   potential                    1 add, 3 mul, 0 div, 0 fn (4 in all)
 //   constraints                  0 add, 5 mul, 0 div, 3 fn (8 in all)
 //   holonomic                    0 add, 0 mul, 0 div, 0 fn (0 in all)
@@ -23,6 +23,8 @@
 //   constraint_drift             4 add, 15 mul, 0 div, 4 fn (23 in all)
 //   accelerations                10 add, 30 mul, 2 div, 4 fn (46 in all)
 //   wall_surface                 1 add, 1 mul, 0 div, 0 fn (2 in all)
+//   wall_normal                  0 add, 0 mul, 0 div, 0 fn (0 in all)
+//   wall_normal_velocity         0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   wall_b_rows                  0 add, 7 mul, 0 div, 4 fn (11 in all)
 //   wall_projector               16 add, 47 mul, 2 div, 4 fn (69 in all)
 //   wall_collide                 31 add, 74 mul, 2 div, 4 fn (111 in all)
@@ -138,7 +140,6 @@ impl BallWallEuler {
     pub fn kinetic_energy(&self, q: &[f32; 5], v: &[f32; 5]) -> f32 {
         let i0: f32 = self.params.m;
         let i2: f32 = self.params.J;
-        let i7: f32 = q[2];
         let i8: f32 = q[3];
         let i10: f32 = v[0];
         let i11: f32 = v[1];
@@ -150,25 +151,15 @@ impl BallWallEuler {
         let o0: f32 = o0 + t1;
         let t1: f32 = i0 * o0;
         let o0: f32 = ::dalembert_runtime::libm::cosf(i8);
+        let o0: f32 = i12 * 2f32 * o0;
+        let o0: f32 = i14 + o0;
         let o0: f32 = i14 * o0;
-        let o0: f32 = i12 + o0;
-        let o0: f32 = o0 * o0;
-        let t2: f32 = ::dalembert_runtime::libm::cosf(i7);
-        let t3: f32 = i13 * t2;
-        let t4: f32 = ::dalembert_runtime::libm::sinf(i7);
-        let t5: f32 = ::dalembert_runtime::libm::sinf(i8);
-        let t5: f32 = i14 * t5;
-        let t6: f32 = t4 * t5;
-        let t3: f32 = t3 + t6;
-        let t6: f32 = t3 * t3;
-        let t3: f32 = i13 * t4;
-        let t4: f32 = -(t2 * t5);
-        let t2: f32 = t3 + t4;
-        let t5: f32 = t2 * t2;
-        let t3: f32 = o0 + t6 + t5;
-        let t4: f32 = i2 * t3;
-        let t2: f32 = t1 + t4;
-        let o0: f32 = 0.5f32 * t2;
+        let t2: f32 = i12 * i12;
+        let t3: f32 = i13 * i13;
+        let o0: f32 = o0 + t2 + t3;
+        let t2: f32 = i2 * o0;
+        let t3: f32 = t1 + t2;
+        let o0: f32 = 0.5f32 * t3;
         o0
     }
     /// Potential energy V(q).
@@ -193,11 +184,12 @@ impl BallWallEuler {
         let i1: f32 = self.params.r;
         let i7: f32 = q[2];
         let i8: f32 = q[3];
-        let o9: f32 = ::dalembert_runtime::libm::sinf(i7);
+        let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
+        let o9: f32 = sc0_sin;
         let o9: f32 = i1 * o9;
         let o3: f32 = -(o9);
         let t2: f32 = ::dalembert_runtime::libm::sinf(i8);
-        let o8: f32 = ::dalembert_runtime::libm::cosf(i7);
+        let o8: f32 = sc0_cos;
         let o8: f32 = i1 * o8;
         let o4: f32 = t2 * o8;
         let o9: f32 = o9 * t2;
@@ -237,13 +229,15 @@ impl BallWallEuler {
         let i13: f32 = v[3];
         let i14: f32 = v[4];
         let o0: f32 = i0 * i4;
-        let o4: f32 = ::dalembert_runtime::libm::sinf(i8);
+        let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
+        let o4: f32 = sc0_sin;
         let t2: f32 = i14 * o4;
         let t3: f32 = i2 * i13;
         let o2: f32 = t2 * t3;
-        let t5: f32 = ::dalembert_runtime::libm::cosf(i7);
+        let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
+        let t5: f32 = sc1_cos;
         let t6: f32 = i13 * t5;
-        let t7: f32 = ::dalembert_runtime::libm::sinf(i7);
+        let t7: f32 = sc1_sin;
         let t8: f32 = t2 * t7;
         let t6: f32 = t6 + t8;
         let t8: f32 = i13 * t7;
@@ -262,7 +256,7 @@ impl BallWallEuler {
         let t10: f32 = t5 * t9;
         let t10: f32 = t11 + t10;
         let t10: f32 = i12 * t10;
-        let t12: f32 = ::dalembert_runtime::libm::cosf(i8);
+        let t12: f32 = sc0_cos;
         let o3: f32 = i14 * t12;
         let t6: f32 = t7 * t6;
         let t14: f32 = 2f32 * o3 * t6;
@@ -307,16 +301,18 @@ impl BallWallEuler {
         let i12: f32 = v[2];
         let i13: f32 = v[3];
         let i14: f32 = v[4];
-        let o1: f32 = ::dalembert_runtime::libm::cosf(i7);
-        let t1: f32 = ::dalembert_runtime::libm::cosf(i8);
+        let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
+        let o1: f32 = sc0_cos;
+        let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
+        let t1: f32 = sc1_cos;
         let t2: f32 = i1 * i14;
         let t1: f32 = i13 * t1;
         let t1: f32 = t2 * t1;
         let t3: f32 = o1 * t1;
         let t4: f32 = i1 * i13;
         let o0: f32 = o1 * t4;
-        let t6: f32 = ::dalembert_runtime::libm::sinf(i7);
-        let t7: f32 = ::dalembert_runtime::libm::sinf(i8);
+        let t6: f32 = sc0_sin;
+        let t7: f32 = sc1_sin;
         let t2: f32 = t2 * t7;
         let t7: f32 = t6 * t2;
         let o0: f32 = o0 + t7;
@@ -349,13 +345,15 @@ impl BallWallEuler {
         let t1: f32 = 1.0 / (t1);
         let t1: f32 = -(t1);
         let o0: f32 = i4 * t0 * t1;
-        let o3: f32 = ::dalembert_runtime::libm::sinf(i8);
+        let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
+        let o3: f32 = sc0_sin;
         let t4: f32 = t0 * o3;
         let t5: f32 = i2 * o3;
         let t4: f32 = t4 + t5;
         let t5: f32 = 1.0 / (t4);
-        let t4: f32 = ::dalembert_runtime::libm::cosf(i7);
-        let o4: f32 = ::dalembert_runtime::libm::cosf(i8);
+        let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
+        let t4: f32 = sc1_cos;
+        let o4: f32 = sc0_cos;
         let o4: f32 = -(o4);
         let o2: f32 = i0 * i4;
         let t4: f32 = i1 * t4;
@@ -372,7 +370,7 @@ impl BallWallEuler {
         let t9: f32 = i14 * o3;
         let t8: f32 = i12 * t9;
         let o3: f32 = i1 * t8;
-        let t9: f32 = ::dalembert_runtime::libm::sinf(i7);
+        let t9: f32 = sc1_sin;
         let t9: f32 = i4 * t9;
         let o3: f32 = o3 + t9;
         let t9: f32 = i0 * i1 * o3;
@@ -400,6 +398,25 @@ impl BallWallEuler {
         let o0: f32 = i5 + o0;
         o0
     }
+    /// Wall `wall`: its normal df(q), the first row of B.
+    #[inline]
+    #[allow(unused_variables)]
+    pub fn wall_normal(&self, q: &[f32; 5]) -> [f32; 5] {
+        let o0: f32 = 1f32;
+        let o1: f32 = 0f32;
+        let o2: f32 = 0f32;
+        let o3: f32 = 0f32;
+        let o4: f32 = 0f32;
+        [o0, o1, o2, o3, o4]
+    }
+    /// Wall `wall`: the normal velocity df(q)·v, negative while approaching.
+    #[inline]
+    #[allow(unused_variables)]
+    pub fn wall_normal_velocity(&self, q: &[f32; 5], v: &[f32; 5]) -> f32 {
+        let i10: f32 = v[0];
+        let o0: f32 = i10;
+        o0
+    }
     /// Wall `wall`: the independent rows of B(q), the normal velocity first.
     #[inline]
     #[allow(unused_variables)]
@@ -407,15 +424,17 @@ impl BallWallEuler {
         let i1: f32 = self.params.r;
         let i7: f32 = q[2];
         let i8: f32 = q[3];
-        let o14: f32 = ::dalembert_runtime::libm::sinf(i7);
+        let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
+        let o14: f32 = sc0_sin;
         let o17: f32 = -(i1);
         let o8: f32 = o14 * o17;
-        let o19: f32 = ::dalembert_runtime::libm::sinf(i8);
-        let o13: f32 = ::dalembert_runtime::libm::cosf(i7);
+        let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
+        let o19: f32 = sc1_sin;
+        let o13: f32 = sc0_cos;
         let o13: f32 = i1 * o13;
         let o9: f32 = o19 * o13;
         let o14: f32 = i1 * o14 * o19;
-        let o19: f32 = ::dalembert_runtime::libm::cosf(i8);
+        let o19: f32 = sc1_cos;
         let o19: f32 = o17 * o19;
         let o0: f32 = 1f32;
         let o1: f32 = 0f32;
@@ -460,12 +479,14 @@ impl BallWallEuler {
         let o6: f32 = 2f32 * o23;
         let o9: f32 = i1 * o23;
         let o7: f32 = -(o9);
-        let t7: f32 = ::dalembert_runtime::libm::cosf(i7);
+        let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
+        let t7: f32 = sc0_cos;
         let o8: f32 = o9 * t7;
-        let t9: f32 = ::dalembert_runtime::libm::sinf(i7);
-        let t10: f32 = ::dalembert_runtime::libm::sinf(i8);
+        let t9: f32 = sc0_sin;
+        let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
+        let t10: f32 = sc1_sin;
         let o14: f32 = t9 * t10;
-        let o19: f32 = ::dalembert_runtime::libm::cosf(i8);
+        let o19: f32 = sc1_cos;
         let o16: f32 = -(o19);
         let t14: f32 = o14 + o16;
         let o9: f32 = o9 * t14;
@@ -554,7 +575,8 @@ impl BallWallEuler {
         let t2: f32 = t1 + t2;
         let t2: f32 = 1.0 / (t2);
         let t3: f32 = i12 * 2f32 * t2;
-        let t4: f32 = ::dalembert_runtime::libm::cosf(i7);
+        let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
+        let t4: f32 = sc0_cos;
         let t5: f32 = t2 * t4;
         let o1: f32 = i13 * -2f32 * t5;
         let t3: f32 = t3 + o1;
@@ -562,12 +584,13 @@ impl BallWallEuler {
         let t3: f32 = i11 * -4f32 * t2;
         let t3: f32 = o1 + t3;
         let o1: f32 = i2 * t3;
-        let t3: f32 = ::dalembert_runtime::libm::sinf(i7);
-        let t7: f32 = ::dalembert_runtime::libm::sinf(i8);
+        let t3: f32 = sc0_sin;
+        let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
+        let t7: f32 = sc1_sin;
         let o3: f32 = i2 * t7;
         let t9: f32 = t3 * o3;
         let t10: f32 = i1 * t9;
-        let o2: f32 = ::dalembert_runtime::libm::cosf(i8);
+        let o2: f32 = sc1_cos;
         let t12: f32 = i2 * o2;
         let t13: f32 = -(i1 * t12);
         let t10: f32 = t10 + t13;
