@@ -1,7 +1,8 @@
 //! Motion between collisions and the hybrid simulator, in one run:
 //!
-//! - `eom/<model>/closed_form`: q̈ at one state from the generated closed
-//!   form (`runtime::dynamics::qdd`, what the simulator calls), side by side
+//! - `eom/<model>/qdd`: q̈ at one state by `runtime::dynamics::qdd`, what
+//!   the simulator calls (the generated closed form; the numeric solve for
+//!   a model without one, such as the structured `chain_8`), side by side
 //!   with `eom/<model>/numeric`: q̈ and λ by the runtime's numeric solve
 //!   (`runtime::dynamics::accelerations`: the generated G, h, A, Ȧq̇ and two
 //!   fixed-size Cholesky solves);
@@ -35,7 +36,7 @@ fn initial<M: Model<N, N>, const N: usize>() -> State<N> {
 fn eom<M: Model<N, N> + Default, const N: usize>(c: &mut Criterion) {
     let m = M::default();
     let s = initial::<M, N>();
-    c.bench_function(&format!("eom/{}/closed_form", M::NAME), |b| {
+    c.bench_function(&format!("eom/{}/qdd", M::NAME), |b| {
         b.iter(|| qdd(black_box(&m), black_box(&s.q), black_box(&s.v)).unwrap())
     });
     c.bench_function(&format!("eom/{}/numeric", M::NAME), |b| {
