@@ -218,7 +218,8 @@ fn latex_matrix(m: &[Vec<String>]) -> Result<String, String> {
     ))
 }
 
-/// `derive --latex`: G, A and, per wall, B, P and the collision law.
+/// `derive --latex`: G, A, q̈ where solved in closed form and, per wall, B,
+/// P and the collision law.
 fn print_latex(d: &Derivation) -> Result<bool, String> {
     let m = &d.model;
     println!(
@@ -229,6 +230,18 @@ fn print_latex(d: &Derivation) -> Result<bool, String> {
     println!("G = {}", latex_matrix(&d.mass_matrix)?);
     if !d.constraint_rows.is_empty() {
         println!("A = {}", latex_matrix(&d.constraint_rows)?);
+    }
+    if let Some(qdd) = &d.accelerations {
+        println!("% equations of motion between collisions, in closed form");
+        println!("\\begin{{aligned}}");
+        for (name, e) in m.coordinates.iter().zip(qdd) {
+            println!(
+                "  \\ddot{{{}}} &= {} \\\\",
+                symbolic::latex(name)?,
+                symbolic::latex(e)?
+            );
+        }
+        println!("\\end{{aligned}}");
     }
     for w in &d.walls {
         println!("% wall `{}`", w.name);
@@ -274,6 +287,12 @@ fn print_derivation(d: &Derivation) -> bool {
         println!("A: no constraints");
     } else {
         print_matrix("A =", &d.constraint_rows);
+    }
+    if let Some(qdd) = &d.accelerations {
+        println!("equations of motion between collisions (G q̈ + h = Aᵀλ, A q̈ + Ȧq̇ = 0), solved:");
+        for (name, e) in m.coordinates.iter().zip(qdd) {
+            println!("  {name}'' = {e}");
+        }
     }
     for w in &d.walls {
         println!("--- wall `{}` ---", w.name);
