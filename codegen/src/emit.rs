@@ -5,13 +5,13 @@
 //! finite input: straight-line arithmetic on fixed arrays with constant
 //! indices, math functions from libm (re-exported by the runtime).
 
+use std::collections::HashMap;
+
 use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::{format_ident, quote};
 
 use crate::Generated;
 use crate::ir::camel;
-use std::collections::HashMap;
-
 use crate::program::{Func, Instr, OpCount, Program, Slot};
 use crate::symbolic::{Derivation, WallDerivation};
 
@@ -883,4 +883,33 @@ pub fn op_counts(d: &Derivation) -> Vec<(String, OpCount)> {
         out.push((format!("{}_collide", w.name), w.programs.collide.op_count()));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// sin and cos pair up only when they take the same value: a slot
+    /// written again between them holds a different one.
+    #[test]
+    fn sincos_pairs_follow_values_not_slot_names() {
+        let (x, t) = (Slot::Input(0), Slot::Temp(0));
+        let p = Program {
+            inputs: 1,
+            consts: vec![1.0],
+            instrs: vec![
+                Instr::Add(t, vec![x, Slot::Const(0)]),
+                Instr::Fun(Slot::Out(0), Func::Sin, t),
+                Instr::Add(t, vec![x, x]),
+                Instr::Fun(Slot::Out(1), Func::Cos, t),
+                Instr::Fun(Slot::Out(2), Func::Cos, x),
+                Instr::Fun(Slot::Out(3), Func::Sin, x),
+            ],
+            outputs: 4,
+        };
+        assert_eq!(
+            sincos_pairs(&p),
+            vec![None, None, None, None, Some((0, true)), Some((0, false))]
+        );
+    }
 }

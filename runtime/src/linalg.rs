@@ -39,10 +39,11 @@ pub fn kinetic_energy<const N: usize>(g: &[[f64; N]; N], v: &[f64; N]) -> f64 {
 /// The Cholesky factor L (G = L Lᵀ) of the leading `n`×`n` block of a
 /// symmetric positive definite matrix, on fixed-size arrays.
 ///
-/// The equations of motion solve with it on every evaluation; on the
-/// 6×6 mass matrix of the ball in flight it is several times faster than
-/// nalgebra's general-purpose static Cholesky (measured with
-/// `cargo bench --bench simulate`, see docs/performance.md).
+/// The numeric solve of the equations of motion (for models without a
+/// closed-form q̈) and structured collision maps use it; on the 6×6 mass
+/// matrix of the ball in flight it was several times faster than nalgebra's
+/// general-purpose static Cholesky (measured with `cargo bench --bench
+/// simulate`, see docs/performance.md).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Cholesky<const N: usize> {
     l: [[f64; N]; N],

@@ -1,8 +1,9 @@
 //! The hybrid simulator: the paper's generalized solutions.
 //!
 //! Between collisions the state (q, q̇) follows the Lagrange–d'Alembert
-//! equations ([`crate::dynamics::qdd`]: the generated closed form, or a numeric solve), integrated by fixed-step
-//! RK4 or by the adaptive Dormand–Prince 5(4) pair, both with dense output
+//! equations ([`crate::dynamics::qdd`]: the generated closed form, or a
+//! numeric solve), integrated by fixed-step RK4 or by the adaptive
+//! Dormand–Prince 5(4) pair, both with dense output
 //! (cubic Hermite for RK4; Shampine's fourth-order continuous extension for
 //! Dormand–Prince, Hairer–Nørsett–Wanner, *Solving ODEs I*, §II.6). After
 //! every step each wall's f(q) is sampled on the dense output; a sign change
