@@ -14,10 +14,9 @@ use dalembert::runtime::dynamics::{DynamicsError, accelerations, qdd};
 use dalembert::runtime::linalg::mat_vec;
 use nalgebra::DMatrix;
 use proptest::prelude::*;
-use proptest::test_runner::{Config, TestRunner};
 
 mod common;
-use common::{lcg, onto_kernel, scaled};
+use common::{for_random_cases, lcg, onto_kernel};
 
 /// v projected onto ker A(q).
 fn admissible<M: Model<N, N>, const N: usize>(m: &M, q: &[f64; N], v: [f64; N]) -> [f64; N] {
@@ -139,8 +138,8 @@ fn check_closed_form<M: Model<Q, N>, const Q: usize, const N: usize>(
     Ok(())
 }
 
-/// Random parameters (the file's values times [1/2, 2]), configurations in
-/// [0.2, 1.4] and velocities in [−3, 3], as in the invariant tests.
+/// 256 random cases (see `common::for_random_cases`), on every model with a
+/// closed form.
 fn closed_form<M: Model<Q, N>, const Q: usize, const N: usize>() {
     let defaults = M::with_params(Default::default());
     if Q == 0
@@ -152,21 +151,7 @@ fn closed_form<M: Model<Q, N>, const Q: usize, const N: usize>() {
         // time (`closed_forms_exist_where_expected` says which are which).
         return;
     }
-    let np = M::PARAMETERS.len();
-    let strategy = (
-        proptest::collection::vec(0.5f64..2.0, np),
-        proptest::array::uniform::<_, Q>(0.2f64..1.4),
-        proptest::array::uniform::<_, N>(-3.0f64..3.0),
-    );
-    let mut runner = TestRunner::new(Config {
-        cases: 256,
-        ..Config::default()
-    });
-    runner
-        .run(&strategy, |(factors, q, v)| {
-            check_closed_form(&scaled::<M, Q, N>(&factors), &q, v)
-        })
-        .unwrap();
+    for_random_cases::<M, Q, N>(256, check_closed_form);
 }
 
 macro_rules! closed_form_test {

@@ -13,9 +13,8 @@ use dalembert::runtime::linalg::{kinetic_energy, mat_mul, mat_vec, projector};
 use dalembert::runtime::{Model, Rows};
 
 mod common;
-use common::{onto_kernel, scaled};
+use common::{for_random_cases, onto_kernel};
 use proptest::prelude::*;
-use proptest::test_runner::{Config, TestRunner};
 
 /// Tolerance relative to the size of the quantities compared.
 const TOL: f64 = 1e-9;
@@ -164,25 +163,9 @@ fn check<M: Model<Q, N>, const Q: usize, const N: usize>(
     Ok(())
 }
 
-/// Random parameters (each the file's value times a factor in [1/2, 2]),
-/// configurations in [0.2, 1.4] per coordinate (clear of the Euler angles'
-/// singularity at θ = 0) and velocities in [−3, 3].
+/// 512 random cases (see `common::for_random_cases`).
 fn run<M: Model<Q, N>, const Q: usize, const N: usize>() {
-    let mut runner = TestRunner::new(Config {
-        cases: 512,
-        ..Config::default()
-    });
-    let np = M::PARAMETERS.len();
-    let strategy = (
-        proptest::collection::vec(0.5f64..2.0, np),
-        proptest::array::uniform::<_, Q>(0.2f64..1.4),
-        proptest::array::uniform::<_, N>(-3.0f64..3.0),
-    );
-    runner
-        .run(&strategy, |(factors, q, v)| {
-            check(&scaled::<M, Q, N>(&factors), &q, v)
-        })
-        .unwrap();
+    for_random_cases::<M, Q, N>(512, check);
 }
 
 macro_rules! invariant_test {

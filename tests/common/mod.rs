@@ -4,6 +4,7 @@
 
 use dalembert::runtime::{Model, Rows};
 use nalgebra::DMatrix;
+use proptest::test_runner::{Config, TestCaseError, TestRunner};
 
 /// v projected onto ker A (Euclidean; membership in ker A does not depend on
 /// the metric). A must have full row rank.
@@ -29,6 +30,29 @@ pub fn lcg(state: &mut u64) -> f64 {
         .wrapping_mul(6364136223846793005)
         .wrapping_add(1442695040888963407);
     (*state >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// Runs `check` on `cases` random cases: the model with random parameters
+/// (each the file's value times a factor in [1/2, 2]), a configuration in
+/// [0.2, 1.4] per coordinate (clear of the Euler angles' singularity at
+/// θ = 0) and velocities in [−3, 3].
+pub fn for_random_cases<M: Model<Q, N>, const Q: usize, const N: usize>(
+    cases: u32,
+    check: impl Fn(&M, &[f64; Q], [f64; N]) -> Result<(), TestCaseError>,
+) {
+    let strategy = (
+        proptest::collection::vec(0.5f64..2.0, M::PARAMETERS.len()),
+        proptest::array::uniform::<_, Q>(0.2f64..1.4),
+        proptest::array::uniform::<_, N>(-3.0f64..3.0),
+    );
+    TestRunner::new(Config {
+        cases,
+        ..Config::default()
+    })
+    .run(&strategy, |(factors, q, v)| {
+        check(&scaled::<M, Q, N>(&factors), &q, v)
+    })
+    .unwrap();
 }
 
 /// The model with each parameter the file's value times `factors[i]`.
