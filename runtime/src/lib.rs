@@ -196,12 +196,10 @@ pub trait Model<const Q: usize, const N: usize> {
     }
 
     /// Normal velocity df(q)·v at the wall: negative while approaching it.
-    /// (Generated models emit it directly; the default takes B's first row.)
+    /// (Generated models emit it directly; the default is [`Model::normal`]
+    /// times v.)
     fn normal_velocity(&self, wall: Self::Wall, q: &[f64; Q], v: &[f64; N]) -> f64 {
-        match self.wall_rows(wall, q).as_slice().first() {
-            Some(row) => linalg::dot(row, v),
-            None => 0.0,
-        }
+        linalg::dot(&self.normal(wall, q), v)
     }
 }
 pub use libm;
