@@ -5,7 +5,8 @@
 //! kinetic energy (2.10), maps ker A into ker A, reverses the wall's normal
 //! velocity and is an involution; the generated P equals the one computed
 //! numerically from G and B by the runtime's generic path; the emitted
-//! normal df and normal velocity agree with B's first row.
+//! normal df and normal velocity agree with B's first row, and the emitted
+//! vᵀ∇²f v with a central difference of df along v.
 
 use dalembert::for_each_model;
 use dalembert::models::*;
@@ -84,6 +85,25 @@ fn check<M: Model<Q, N>, const Q: usize, const N: usize>(
             "{} {name}: normal velocity ≠ B's first row · v",
             M::NAME
         );
+        // vᵀ∇²f v is the rate of df along v, times v.
+        if Q == N {
+            let eps = 1e-5;
+            let shifted = |sign: f64| {
+                let qs: [f64; Q] = core::array::from_fn(|i| q[i] + sign * eps * v[i]);
+                model.normal(wall, &qs)
+            };
+            let (ahead, behind) = (shifted(1.0), shifted(-1.0));
+            let difference: f64 =
+                (0..N).map(|j| (ahead[j] - behind[j]) * v[j]).sum::<f64>() / (2.0 * eps);
+            let hessian = model.surface_hessian(wall, q, &v);
+            let vmax = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+            prop_assert!(
+                hessian
+                    .is_some_and(|h| (h - difference).abs() <= 1e-5 * (1.0 + size * vmax * vmax)),
+                "{} {name}: vᵀ∇²f v = {hessian:?}, a central difference gives {difference}",
+                M::NAME
+            );
+        }
         // AP = A and BP = B
         for (what, rows) in [("A", &a), ("B", &b)] {
             for row in rows.as_slice() {

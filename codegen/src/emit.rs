@@ -300,6 +300,13 @@ fn wall_fns(d: &Derivation, w: &WallDerivation) -> TokenStream {
         &w.programs.normal_velocity,
         true,
     );
+    let hessian = fn_scalar(
+        d,
+        &format!("{name}_surface_hessian"),
+        &format!("Wall `{name}`: vᵀ∇²f(q)v; along a motion f̈ = df(q)·q̈ + vᵀ∇²f(q)v."),
+        &w.programs.surface_hessian,
+        true,
+    );
     let rows = fn_rows(
         d,
         &format!("{name}_b_rows"),
@@ -309,7 +316,7 @@ fn wall_fns(d: &Derivation, w: &WallDerivation) -> TokenStream {
     );
     if w.structured {
         let structured = structured_fns(d, w);
-        return quote! { #surface #normal_row #normal #rows #structured };
+        return quote! { #surface #normal_row #normal #hessian #rows #structured };
     }
     let projector = fn_matrix(
         d,
@@ -325,7 +332,7 @@ fn wall_fns(d: &Derivation, w: &WallDerivation) -> TokenStream {
         &w.programs.collide,
         true,
     );
-    quote! { #surface #normal_row #normal #rows #projector #collide }
+    quote! { #surface #normal_row #normal #hessian #rows #projector #collide }
 }
 
 /// P and the collision map of a wall evaluated at run time from the
@@ -738,6 +745,13 @@ fn trait_impl(d: &Derivation) -> TokenStream {
     let collide = per_wall("collide", quote! { q, v });
     let normal = per_wall("normal_velocity", quote! { q, v });
     let normal_row = per_wall("normal", quote! { q });
+    let hessian = {
+        let arms = d.walls.iter().zip(&variants).map(|(w, v)| {
+            let f = format_ident!("{}_surface_hessian", w.name);
+            quote! { Wall::#v => Some(self.#f(q, v)) }
+        });
+        quote! { match wall { #(#arms,)* } }
+    };
     let accelerations = d.programs.accelerations.as_ref().map(|_| {
         quote! {
             #[inline]
@@ -795,6 +809,8 @@ fn trait_impl(d: &Derivation) -> TokenStream {
             fn normal(&self, wall: Wall, q: &[f64; #ql]) -> [f64; #nl] { #normal_row }
             #[inline]
             fn normal_velocity(&self, wall: Wall, q: &[f64; #ql], v: &[f64; #nl]) -> f64 { #normal }
+            #[inline]
+            fn surface_hessian(&self, wall: Wall, q: &[f64; #ql], v: &[f64; #nl]) -> Option<f64> { #hessian }
         }
     }
 }
@@ -871,6 +887,10 @@ pub fn op_counts(d: &Derivation) -> Vec<(String, OpCount)> {
         out.push((
             format!("{}_normal_velocity", w.name),
             w.programs.normal_velocity.op_count(),
+        ));
+        out.push((
+            format!("{}_surface_hessian", w.name),
+            w.programs.surface_hessian.op_count(),
         ));
         out.push((format!("{}_b_rows", w.name), w.programs.rows.op_count()));
         if w.structured {

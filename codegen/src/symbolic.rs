@@ -84,6 +84,8 @@ pub struct WallPrograms {
     pub normal: Program,
     /// The normal velocity df·v.
     pub normal_velocity: Program,
+    /// vᵀ∇²f(q)v: with df·q̈, the second time derivative of f along a motion.
+    pub surface_hessian: Program,
     /// P (n² outputs).
     pub projector: Program,
     /// (I − 2P)v (n outputs).
@@ -264,7 +266,7 @@ impl<'a> Deriver<'a> {
         everything.extend([t.clone(), v_atom.clone()]);
         let mut walls_raw = Vec::new();
         for w in &m.walls {
-            let (surface, normal) = match m.kind {
+            let (surface, normal, hessian) = match m.kind {
                 Kind::Coordinates => {
                     let f = self.parse(w.surface.as_ref()?)?;
                     let span = w
@@ -280,12 +282,13 @@ impl<'a> Deriver<'a> {
                     for (k, q) in self.coords.iter().enumerate() {
                         row[k] = f.derivative(*q).expand();
                     }
-                    (f, row)
+                    let hessian = self.hessian_form(&row);
+                    (f, row, hessian)
                 }
                 Kind::Instantaneous => {
                     let e = w.normal_velocity.as_ref()?;
                     let atom = self.parse(e)?;
-                    (Atom::num(0), self.linear_row(&atom, &e.span)?)
+                    (Atom::num(0), self.linear_row(&atom, &e.span)?, Atom::num(0))
                 }
             };
             let mut contact = Vec::new();
@@ -294,8 +297,9 @@ impl<'a> Deriver<'a> {
                 contact.push(self.linear_row(&e, &c.span)?);
             }
             everything.extend(normal.iter().cloned());
+            everything.push(hessian.clone());
             everything.extend(contact.iter().flatten().cloned());
-            walls_raw.push((surface, normal, contact));
+            walls_raw.push((surface, normal, hessian, contact));
         }
         self.lower_functions(&everything);
 
@@ -344,7 +348,7 @@ impl<'a> Deriver<'a> {
         };
 
         let mut walls = Vec::new();
-        for (w, (surface, normal, contact)) in m.walls.iter().zip(walls_raw) {
+        for (w, (surface, normal, hessian, contact)) in m.walls.iter().zip(walls_raw) {
             let normal_r: Vec<Rat> = normal.iter().map(|a| to_rat(self, a)).collect();
             let contact_r: Vec<Vec<Rat>> = contact
                 .iter()
@@ -409,6 +413,7 @@ impl<'a> Deriver<'a> {
                 surface: self.program(std::slice::from_ref(&surface), &inputs)?,
                 normal: self.program(&normal, &inputs)?,
                 normal_velocity: self.program(std::slice::from_ref(&normal_velocity), &inputs)?,
+                surface_hessian: self.program(&[self.reduce_atom(&hessian, &vars)], &inputs)?,
                 rows: self.program(
                     &b_atoms.iter().flatten().cloned().collect::<Vec<_>>(),
                     &inputs,
@@ -560,6 +565,19 @@ impl<'a> Deriver<'a> {
                 Some(span),
             );
         }
+    }
+
+    /// vᵀ∇²f(q)v from the normal df = `row`: Σₖ (Σᵢ ∂ₖ∂ᵢf vᵢ) vₖ.
+    fn hessian_form(&self, row: &[Atom]) -> Atom {
+        let mut form = Atom::num(0);
+        for (k, entry) in row.iter().enumerate() {
+            let mut rate = Atom::num(0);
+            for (i, q) in self.coords.iter().enumerate() {
+                rate += entry.derivative(*q) * Atom::from(self.vels[i]);
+            }
+            form += rate * Atom::from(self.vels[k]);
+        }
+        form.expand()
     }
 
     /// The coefficient row of a velocity-level expression, which must be

@@ -201,5 +201,14 @@ pub trait Model<const Q: usize, const N: usize> {
     fn normal_velocity(&self, wall: Self::Wall, q: &[f64; Q], v: &[f64; N]) -> f64 {
         linalg::dot(&self.normal(wall, q), v)
     }
+
+    /// vᵀ∇²f(q)v for the wall's surface f: along a motion the second time
+    /// derivative of f is f̈ = df(q)·q̈ + vᵀ∇²f(q)v. The simulator uses it to
+    /// end steps where a collision is predicted. Generated models emit it;
+    /// the default `None` (unknown) means steps are not aimed at this wall.
+    fn surface_hessian(&self, wall: Self::Wall, q: &[f64; Q], v: &[f64; N]) -> Option<f64> {
+        let _ = (wall, q, v);
+        None
+    }
 }
 pub use libm;

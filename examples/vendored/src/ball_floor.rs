@@ -17,6 +17,7 @@
 //   floor_surface                0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_normal                 0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_normal_velocity        0 add, 0 mul, 0 div, 0 fn (0 in all)
+//   floor_surface_hessian        0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_b_rows                 0 add, 1 mul, 0 div, 0 fn (1 in all)
 //   floor_projector              1 add, 10 mul, 1 div, 0 fn (12 in all)
 //   floor_collide                8 add, 19 mul, 1 div, 0 fn (28 in all)
@@ -221,6 +222,13 @@ impl BallFloor {
     pub fn floor_normal_velocity(&self, q: &[f64; 0], v: &[f64; 6]) -> f64 {
         let i5: f64 = v[2];
         let o0: f64 = i5;
+        o0
+    }
+    /// Wall `floor`: vᵀ∇²f(q)v; along a motion f̈ = df(q)·q̈ + vᵀ∇²f(q)v.
+    #[inline]
+    #[allow(unused_variables)]
+    pub fn floor_surface_hessian(&self, q: &[f64; 0], v: &[f64; 6]) -> f64 {
+        let o0: f64 = 0f64;
         o0
     }
     /// Wall `floor`: the independent rows of B(q), the normal velocity first.
@@ -467,6 +475,12 @@ impl ::dalembert_runtime::Model<0, 6> for BallFloor {
     fn normal_velocity(&self, wall: Wall, q: &[f64; 0], v: &[f64; 6]) -> f64 {
         match wall {
             Wall::Floor => self.floor_normal_velocity(q, v),
+        }
+    }
+    #[inline]
+    fn surface_hessian(&self, wall: Wall, q: &[f64; 0], v: &[f64; 6]) -> Option<f64> {
+        match wall {
+            Wall::Floor => Some(self.floor_surface_hessian(q, v)),
         }
     }
 }

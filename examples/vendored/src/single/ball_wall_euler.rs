@@ -25,6 +25,7 @@
 //   wall_surface                 1 add, 1 mul, 0 div, 0 fn (2 in all)
 //   wall_normal                  0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   wall_normal_velocity         0 add, 0 mul, 0 div, 0 fn (0 in all)
+//   wall_surface_hessian         0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   wall_b_rows                  0 add, 7 mul, 0 div, 4 fn (11 in all)
 //   wall_projector               16 add, 47 mul, 2 div, 4 fn (69 in all)
 //   wall_collide                 31 add, 74 mul, 2 div, 4 fn (111 in all)
@@ -415,6 +416,13 @@ impl BallWallEuler {
     pub fn wall_normal_velocity(&self, q: &[f32; 5], v: &[f32; 5]) -> f32 {
         let i10: f32 = v[0];
         let o0: f32 = i10;
+        o0
+    }
+    /// Wall `wall`: vᵀ∇²f(q)v; along a motion f̈ = df(q)·q̈ + vᵀ∇²f(q)v.
+    #[inline]
+    #[allow(unused_variables)]
+    pub fn wall_surface_hessian(&self, q: &[f32; 5], v: &[f32; 5]) -> f32 {
+        let o0: f32 = 0f32;
         o0
     }
     /// Wall `wall`: the independent rows of B(q), the normal velocity first.
