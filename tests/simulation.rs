@@ -2,10 +2,12 @@
 //! pendulum's period (elliptic integral), the pendulum bouncing off a wall,
 //! the paper's §3.2.1 nonholonomic pendulum over more than a thousand
 //! bounces, the rolling ball meeting the wall (Theorem 3.1), two masses in a
-//! box (the textbook law, event by event), and the contacts that must be
-//! reported rather than resolved.
+//! box (the textbook law, event by event), a chain whose tip meets the
+//! floor along a curved path (adaptive steps aimed at predicted collisions
+//! against fixed RK4 steps), and the contacts that must be reported rather
+//! than resolved.
 
-use dalembert::models::{BallBounce, BallWallEuler, MassesOnLine, PendulumWall};
+use dalembert::models::{BallBounce, BallWallEuler, Chain3, MassesOnLine, PendulumWall};
 use dalembert::runtime::Model;
 use dalembert::runtime::dynamics::DynamicsError;
 use dalembert::runtime::simulate::{Integrator, Settings, SimError, Simulator, State, admissible};
@@ -46,6 +48,15 @@ fn dormand_prince(rtol: f64) -> Settings {
             max_step: f64::INFINITY,
         },
         ..Settings::default()
+    }
+}
+
+/// The model file's initial state.
+fn initial<M: Model<N, N>, const N: usize>() -> State<N> {
+    State {
+        t: 0.0,
+        q: M::INITIAL_COORDINATES,
+        v: M::INITIAL_VELOCITIES,
     }
 }
 
@@ -204,6 +215,75 @@ fn nonholonomic_pendulum_is_periodic_over_ten_thousand_bounces() {
     assert!(worst[0] < 1e-11, "relative time error {}", worst[0]);
     assert!(worst[1] < 1e-10, "position error {}", worst[1]);
     assert!(worst[2] < 1e-10, "energy error {}", worst[2]);
+}
+
+/// A flight in uniform gravity has f quadratic in time: each step is aimed
+/// at the predicted bounce and ends on the floor, so a bounce costs one
+/// step (six evaluations) and one evaluation after the collision map, with
+/// no step across the floor to redo.
+#[test]
+fn parabolic_flights_end_on_the_floor_in_one_step() {
+    let ball = BallBounce::default();
+    let start = initial::<BallBounce, 6>();
+    let flight = 2.0 * 2.0 / ball.params.g;
+    let mut sim = Simulator::new(&ball, start, Settings::default()).unwrap();
+    let mut n = 0u64;
+    let stats = sim
+        .run(100.5 * flight, |s| {
+            if let Some(c) = s.collision {
+                n += 1;
+                assert!(
+                    (c.t - n as f64 * flight).abs() <= 1e-12 * c.t,
+                    "bounce {n} at {}",
+                    c.t
+                );
+                assert!(c.surface.abs() <= 1e-14, "bounce {n}: f = {:e}", c.surface);
+            }
+            true
+        })
+        .unwrap();
+    assert_eq!(stats.collisions, 100);
+    // A few steps while the step size grows from its first guess.
+    assert!(stats.steps <= 110, "{stats:?}");
+    assert!(stats.evaluations <= 7 * 100 + 60, "{stats:?}");
+}
+
+/// The tip of the triple pendulum meets the floor along a curved path (f
+/// has a non-zero Hessian): the adaptive integrator, whose steps are aimed
+/// at predicted collisions, finds the same collisions as fixed small RK4
+/// steps, which are never aimed.
+#[test]
+fn aimed_steps_find_the_collisions_fixed_steps_find() {
+    let chain = Chain3::default();
+    let start = initial::<Chain3, 3>();
+    let collisions = |settings: Settings| {
+        let mut sim = Simulator::new(&chain, start, settings).unwrap();
+        let mut found = Vec::new();
+        sim.run(3.0, |s| {
+            found.extend(s.collision);
+            true
+        })
+        .unwrap();
+        found
+    };
+    let adaptive = collisions(dormand_prince(1e-11));
+    let fixed = collisions(Settings {
+        integrator: Integrator::Rk4 { step: 1e-4 },
+        ..Settings::default()
+    });
+    eprintln!("{} collisions", adaptive.len());
+    assert!(adaptive.len() >= 4, "{adaptive:?}");
+    assert_eq!(adaptive.len(), fixed.len());
+    let e0 = chain.energy(&start.q, &start.v);
+    for (a, f) in adaptive.iter().zip(&fixed) {
+        eprintln!("t {} vs {}: |Δt| {:.1e}", a.t, f.t, (a.t - f.t).abs());
+        assert!((a.t - f.t).abs() < 1e-8, "{} vs {}", a.t, f.t);
+        for i in 0..3 {
+            assert!((a.q[i] - f.q[i]).abs() < 1e-7 && (a.v_plus[i] - f.v_plus[i]).abs() < 1e-6);
+        }
+        assert!(a.surface.abs() < 1e-13, "f = {:e}", a.surface);
+        assert!((chain.energy(&a.q, &a.v_plus) - e0).abs() < 1e-9 * e0.abs().max(1.0));
+    }
 }
 
 // ------------------------------------------------------------ §3.1

@@ -13,6 +13,15 @@
 //! at the level of rounding. There the collision map v⁺ = (I − 2P)v⁻ is
 //! applied and the integration resumes.
 //!
+//! Adaptive steps are also *aimed*: before a step, each wall's f is
+//! predicted by its second-order Taylor polynomial in time (f, df·q̇ and
+//! f̈ = df·q̈ + q̇ᵀ∇²f q̇, from [`Model::surface_hessian`]) and the step is
+//! made to end where that polynomial first falls through zero. Where f is
+//! quadratic in time (a flight in uniform gravity to a plane) the step ends
+//! on the wall and the collision is polished from its end by a Taylor step,
+//! so no step across the wall has to be redone; elsewhere the prediction
+//! only shortens a step and the crossing is found as above.
+//!
 //! Nothing is silently wrong: two walls met within
 //! [`Settings::simultaneous`] of each other, a contact whose normal velocity
 //! is too small to tell whether the wall is met ([`Settings::grazing`]), a
@@ -542,11 +551,37 @@ impl<'m, M: Model<N, N>, const N: usize> Simulator<'m, M, N> {
         if t_end <= t0 {
             return Ok(self.report(t0, None));
         }
-        let (h, trial) = self.accepted_trial(&y0, t_end)?;
+        let aim = self.aim(&y0);
+        let (h, trial) =
+            self.accepted_trial(&y0, t_end, aim.map_or(f64::INFINITY, |(_, tau)| tau))?;
         let t1 = if t0 + h >= t_end { t_end } else { t0 + h };
-        match self.first_crossing(&y0, &trial, t0, h)? {
+        let reach = TAYLOR_REACH * h;
+        let found = match self.first_crossing(&y0, &trial, t0, h)? {
+            Some((k, tc)) if t1 - tc <= reach => {
+                // Met at the very end of the step: polish from there.
+                Some((k, (t1, trial.y1, Some(trial.f1)), t1))
+            }
             Some((k, tc)) => {
-                let collision = self.collide(k, &y0, t0, tc, t1)?;
+                let (y, fy) = self.advance(&y0, t0, tc - t0)?;
+                Some((k, (tc, y, fy), t1))
+            }
+            // A step aimed at a predicted collision that ends just short of
+            // the wall: the collision is a Taylor step ahead.
+            None => aim.filter(|&(_, tau)| tau == h).and_then(|(k, _)| {
+                let wall = M::WALLS[k];
+                let f = self.model.surface(wall, &trial.y1.q);
+                let nv = self.model.normal_velocity(wall, &trial.y1.q, &trial.y1.v);
+                let ahead = -f / nv;
+                (f > 0.0 && nv < 0.0 && ahead <= reach && t1 + ahead <= t_end).then_some((
+                    k,
+                    (t1, trial.y1, Some(trial.f1)),
+                    t1 + ahead,
+                ))
+            }),
+        };
+        match found {
+            Some((k, start, t_hi)) => {
+                let collision = self.collide(k, &y0, t0, start, t_hi)?;
                 self.stats.steps += 1;
                 self.stats.collisions += 1;
                 Ok(self.report(t0, Some(collision)))
@@ -719,17 +754,50 @@ impl<'m, M: Model<N, N>, const N: usize> Simulator<'m, M, N> {
         }
     }
 
-    /// Trial steps until one is accepted; returns its length.
+    /// The wall the motion from y0 is predicted to meet first and when, from
+    /// f's second-order Taylor polynomial in time (adaptive integrator
+    /// only): the next step is made to end there. A motion whose f is
+    /// quadratic in time (a flight in uniform gravity to a plane) then meets
+    /// the wall at the end of one step, with no step across it to redo; for
+    /// other motions the prediction only shortens a step, and the crossing
+    /// is found on the step as usual.
+    fn aim(&self, y0: &Y<N>) -> Option<(usize, f64)> {
+        if !matches!(self.settings.integrator, Integrator::DormandPrince { .. }) {
+            return None;
+        }
+        let m = self.model;
+        let shortest = 16.0 * f64::EPSILON * self.state.t.abs().max(1.0);
+        let mut best: Option<(usize, f64)> = None;
+        for (k, &wall) in M::WALLS.iter().enumerate() {
+            let Some(hessian) = m.surface_hessian(wall, &y0.q, &y0.v) else {
+                continue;
+            };
+            let f = m.surface(wall, &y0.q);
+            let rate = m.normal_velocity(wall, &y0.q, &y0.v);
+            let accel = linalg::dot(&m.normal(wall, &y0.q), &self.f0.v) + hessian;
+            if let Some(tau) = descending_root(f, rate, accel)
+                && tau > shortest
+                && best.is_none_or(|(_, b)| tau < b)
+            {
+                best = Some((k, tau));
+            }
+        }
+        best
+    }
+
+    /// Trial steps of at most `limit` until one is accepted; returns its
+    /// length.
     fn accepted_trial(
         &mut self,
         y0: &Y<N>,
         t_end: f64,
+        limit: f64,
     ) -> Result<(f64, Trial<N>), SimError<M::Wall>> {
         let t0 = self.state.t;
         let mut rejected = false;
         let mut failures = 0;
         loop {
-            let h = self.h.min(t_end - t0);
+            let h = self.h.min(t_end - t0).min(limit);
             if h <= 4.0 * f64::EPSILON * t0.abs().max(1.0) && t0 + h < t_end {
                 return Err(SimError::StepTooSmall { t: t0, step: h });
             }
@@ -765,8 +833,11 @@ impl<'m, M: Model<N, N>, const N: usize> Simulator<'m, M, N> {
             };
             if err <= 1.0 {
                 let fac = if rejected { fac.min(1.0) } else { fac };
-                // A step cut short by t_end keeps the longer proposal.
-                self.h = (self.h.max(h) * fac).min(max_step);
+                // A step cut short by t_end or by an aim says nothing
+                // against the longer proposal: keep it if it is longer.
+                let grown = h * fac;
+                let proposal = if h < self.h { self.h.max(grown) } else { grown };
+                self.h = proposal.min(max_step);
                 return Ok((h, trial));
             }
             self.h = h * fac.min(1.0);
@@ -909,32 +980,35 @@ impl<'m, M: Model<N, N>, const N: usize> Simulator<'m, M, N> {
         Ok(None)
     }
 
-    /// Resolves the collision with wall `k` found near `tc` on the step
-    /// from (t0, y0): Newton's method on f along real steps, then the
-    /// collision map.
+    /// Resolves the collision with wall `k` met on the step from (t0, y0):
+    /// Newton's method on f from `start` (a time, the state there from a
+    /// real step, and f there when known) along real steps or, for tiny
+    /// corrections, Taylor steps, staying in [t0, t_hi]; then the collision
+    /// map.
     fn collide(
         &mut self,
         k: usize,
         y0: &Y<N>,
         t0: f64,
-        mut tc: f64,
-        t1: f64,
+        start: (f64, Y<N>, Option<Y<N>>),
+        t_hi: f64,
     ) -> Result<Collision<M::Wall, N>, SimError<M::Wall>> {
         let m = self.model;
         let wall = M::WALLS[k];
-        let (mut y, mut fy) = self.advance(y0, t0, tc - t0)?;
+        let (mut tc, mut y, mut fy) = start;
+        let reach = TAYLOR_REACH * (t_hi - t0);
         for _ in 0..6 {
             let f = m.surface(wall, &y.q);
             let nv = m.normal_velocity(wall, &y.q, &y.v);
             if f == 0.0 || nv >= 0.0 {
                 break;
             }
-            let next = (tc - f / nv).clamp(t0, t1);
+            let next = (tc - f / nv).clamp(t0, t_hi);
             if (next - tc).abs() <= 2.0 * f64::EPSILON * tc.abs().max(1.0) || next <= t0 {
                 break;
             }
             let delta = next - tc;
-            let (candidate, f_candidate) = if delta.abs() <= 1e-6 * (t1 - t0) {
+            let (candidate, f_candidate) = if delta.abs() <= reach {
                 // A tiny correction: second-order Taylor from y (at most one
                 // evaluation instead of a step; the error is O(δ³)).
                 let d = match fy {
@@ -1126,6 +1200,29 @@ fn scaled_norm<const N: usize>(e: &Y<N>, a: &Y<N>, b: &Y<N>, rtol: f64, atol: f6
     }
 }
 
+/// A Newton or Taylor correction from a point on a step of length h is
+/// trusted up to this fraction of h (its error is O(δ³) in q, O(δ²) in q̇).
+const TAYLOR_REACH: f64 = 1e-6;
+
+/// The first τ > 0 at which f + rate·τ + accel·τ²/2 falls through zero
+/// (its slope there negative), if there is one.
+fn descending_root(f: f64, rate: f64, accel: f64) -> Option<f64> {
+    // The descending root is (−rate − s)/accel with s = √(rate² − 2·accel·f);
+    // for rate ≤ 0 the same value in the form 2f/(s − rate), which does not
+    // cancel (and covers accel = 0).
+    let disc = rate * rate - 2.0 * accel * f;
+    if disc.is_nan() || disc < 0.0 {
+        return None;
+    }
+    let s = libm::sqrt(disc);
+    let tau = if rate > 0.0 {
+        (-rate - s) / accel
+    } else {
+        2.0 * f / (s - rate)
+    };
+    (tau > 0.0 && tau.is_finite()).then_some(tau)
+}
+
 /// The root of `f` in [a, b] with f(a) > 0 ≥ f(b), by the Illinois variant
 /// of regula falsi; returns θ.
 fn illinois(f: &impl Fn(f64) -> f64, a: (f64, f64), b: (f64, f64)) -> f64 {
@@ -1157,4 +1254,38 @@ fn illinois(f: &impl Fn(f64) -> f64, a: (f64, f64), b: (f64, f64)) -> f64 {
         }
     }
     b
+}
+
+#[cfg(test)]
+mod tests {
+    use super::descending_root;
+
+    fn close(a: Option<f64>, b: f64) -> bool {
+        a.is_some_and(|a| (a - b).abs() <= 1e-14 * b.abs())
+    }
+
+    #[test]
+    fn descending_roots() {
+        // Thrown up from the wall: back after 2·rate/|accel|, not at the
+        // start (where f rises through zero), also a rounding below it.
+        assert!(close(descending_root(0.0, 2.0, -10.0), 0.4));
+        assert!(close(descending_root(-1e-17, 2.0, -10.0), 0.4));
+        // Falling from height 5 at rest: √(2·5/10) = 1.
+        assert!(close(descending_root(5.0, 0.0, -10.0), 1.0));
+        // Approaching at constant speed: f/|rate|.
+        assert!(close(descending_root(3.0, -2.0, 0.0), 1.5));
+        // Approaching while pushed back: the earlier of the two roots of
+        // 1 − 3τ + τ² (τ = (3 − √5)/2), not the later one where f rises.
+        assert!(close(
+            descending_root(1.0, -3.0, 2.0),
+            (3.0 - 5f64.sqrt()) / 2.0
+        ));
+        // Turning back before the wall, moving away, or already beyond it
+        // and approaching: no meeting ahead.
+        assert_eq!(descending_root(1.0, -1.0, 2.0), None);
+        assert_eq!(descending_root(1.0, 1.0, 0.0), None);
+        assert_eq!(descending_root(1.0, 1.0, 2.0), None);
+        assert_eq!(descending_root(-1.0, -1.0, 0.0), None);
+        assert_eq!(descending_root(f64::NAN, -1.0, 0.0), None);
+    }
 }
