@@ -6,7 +6,8 @@
 //!   with `eom/<model>/numeric`: q̈ and λ by the runtime's numeric solve
 //!   (`runtime::dynamics::accelerations`: the generated G, h, A, Ȧq̇ and two
 //!   fixed-size Cholesky solves);
-//! - `step/<model>/<method>`: one accepted integrator step, projection and
+//! - `step/<model>/<method>`: one accepted integrator step from the model
+//!   file's initial state, for every model of the `eom` rows, projection and
 //!   crossing checks included;
 //! - `simulate/ball_bounce_{100,1000}_bounces`: the §3.2.1 nonholonomic
 //!   pendulum from the model file's initial state through 100 and 1000
@@ -102,6 +103,9 @@ fn all(c: &mut Criterion) {
     step::<BallBounce, 6>(c);
     step::<BallWallEuler, 5>(c);
     step::<PendulumWall, 2>(c);
+    step::<Puck, 3>(c);
+    step::<Chain3, 3>(c);
+    step::<Chain8, 8>(c);
     simulate(c);
 }
 
