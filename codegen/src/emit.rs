@@ -732,26 +732,24 @@ fn trait_impl(d: &Derivation) -> TokenStream {
     let pidx: Vec<Literal> = (0..pidents.len()).map(Literal::usize_unsuffixed).collect();
     let coords = &d.model.coordinates;
     let vels = &d.model.velocities;
-    let per_wall = |suffix: &str, call: TokenStream| {
-        let arms = d.walls.iter().zip(&variants).map(|(w, v)| {
-            let f = format_ident!("{}_{}", w.name, suffix);
-            quote! { Wall::#v => self.#f(#call) }
-        });
-        quote! { match wall { #(#arms,)* } }
-    };
+    // `match wall { Wall::X => wrap(self.x_suffix(call)), … }`.
+    let per_wall_wrapped =
+        |suffix: &str, call: TokenStream, wrap: fn(TokenStream) -> TokenStream| {
+            let arms = d.walls.iter().zip(&variants).map(|(w, v)| {
+                let f = format_ident!("{}_{}", w.name, suffix);
+                let value = wrap(quote! { self.#f(#call) });
+                quote! { Wall::#v => #value }
+            });
+            quote! { match wall { #(#arms,)* } }
+        };
+    let per_wall = |suffix: &str, call: TokenStream| per_wall_wrapped(suffix, call, |e| e);
     let surface = per_wall("surface", quote! { q });
     let rows = per_wall("b_rows", quote! { q });
     let projector = per_wall("projector", quote! { q });
     let collide = per_wall("collide", quote! { q, v });
     let normal = per_wall("normal_velocity", quote! { q, v });
     let normal_row = per_wall("normal", quote! { q });
-    let hessian = {
-        let arms = d.walls.iter().zip(&variants).map(|(w, v)| {
-            let f = format_ident!("{}_surface_hessian", w.name);
-            quote! { Wall::#v => Some(self.#f(q, v)) }
-        });
-        quote! { match wall { #(#arms,)* } }
-    };
+    let hessian = per_wall_wrapped("surface_hessian", quote! { q, v }, |e| quote! { Some(#e) });
     let accelerations = d.programs.accelerations.as_ref().map(|_| {
         quote! {
             #[inline]
