@@ -773,8 +773,9 @@ impl<'m, M: Model<N, N>, const N: usize> Simulator<'m, M, N> {
                 continue;
             };
             let f = m.surface(wall, &y0.q);
-            let rate = m.normal_velocity(wall, &y0.q, &y0.v);
-            let accel = linalg::dot(&m.normal(wall, &y0.q), &self.f0.v) + hessian;
+            let normal = m.normal(wall, &y0.q);
+            let rate = linalg::dot(&normal, &y0.v);
+            let accel = linalg::dot(&normal, &self.f0.v) + hessian;
             if let Some(tau) = descending_root(f, rate, accel)
                 && tau > shortest
                 && best.is_none_or(|(_, b)| tau < b)
