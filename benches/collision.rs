@@ -16,8 +16,8 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use dalembert::models::{BallFloor, BallWall};
-use dalembert::runtime::Model;
 use dalembert::runtime::linalg::{projector, reflect};
+use dalembert::runtime::prelude::*;
 use nalgebra::{DMatrix, DVector};
 
 /// Theorem 3.1 for admissible v = (v1, v2, w1, w2, w3), with w1, w2 of v⁺ from
@@ -58,7 +58,7 @@ fn generic_dynamic(g: &DMatrix<f64>, b: &DMatrix<f64>, v: &DVector<f64>) -> DVec
     v - 2.0 * p * v
 }
 
-fn dynamic_inputs<M: Model<0, N>, const N: usize>(
+fn dynamic_inputs<M: Walls<0, N>, const N: usize>(
     model: &M,
     wall: M::Wall,
 ) -> (DMatrix<f64>, DMatrix<f64>) {
@@ -71,7 +71,7 @@ fn dynamic_inputs<M: Model<0, N>, const N: usize>(
 
 /// The four paths for one instantaneous model's first wall, after checking
 /// that the generated and hand-written maps agree at `v`.
-fn compare<M: Model<0, N>, const N: usize>(
+fn compare<M: Walls<0, N>, const N: usize>(
     c: &mut Criterion,
     group: &str,
     model: &M,
@@ -129,7 +129,7 @@ fn section_3_2(c: &mut Criterion) {
 /// configuration, n = 1…8 (closed forms for n ≤ 3, structured above), and
 /// chain_4 with its closed form for comparison.
 fn chains(c: &mut Criterion) {
-    fn one<M: Model<N, N> + Default, const N: usize>(
+    fn one<M: Surfaces<N> + Default, const N: usize>(
         g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
     ) {
         let m = M::default();

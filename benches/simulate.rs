@@ -22,11 +22,11 @@ use std::hint::black_box;
 
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
 use dalembert::models::{BallBounce, BallWallEuler, Chain3, Chain8, PendulumWall, Puck};
-use dalembert::runtime::Model;
 use dalembert::runtime::dynamics::{accelerations, qdd};
-use dalembert::runtime::simulate::{Integrator, Settings, Simulator, State};
+use dalembert::runtime::prelude::*;
+use dalembert::runtime::simulate::{Integrator, Rk4, Settings, Simulator, State};
 
-fn initial<M: Model<N, N>, const N: usize>() -> State<N> {
+fn initial<M: Dynamics<N>, const N: usize>() -> State<N> {
     State {
         t: 0.0,
         q: M::INITIAL_COORDINATES,
@@ -34,7 +34,7 @@ fn initial<M: Model<N, N>, const N: usize>() -> State<N> {
     }
 }
 
-fn eom<M: Model<N, N> + Default, const N: usize>(c: &mut Criterion) {
+fn eom<M: Dynamics<N> + Default, const N: usize>(c: &mut Criterion) {
     let m = M::default();
     let s = initial::<M, N>();
     c.bench_function(&format!("eom/{}/qdd", M::NAME), |b| {
@@ -47,12 +47,12 @@ fn eom<M: Model<N, N> + Default, const N: usize>(c: &mut Criterion) {
 
 fn rk4() -> Settings {
     Settings {
-        integrator: Integrator::Rk4 { step: 1e-3 },
+        integrator: Integrator::Rk4(Rk4 { step: 1e-3 }),
         ..Settings::default()
     }
 }
 
-fn step<M: Model<N, N> + Default, const N: usize>(c: &mut Criterion) {
+fn step<M: Surfaces<N> + Default, const N: usize>(c: &mut Criterion) {
     let m = M::default();
     for (name, settings) in [("dormand_prince", Settings::default()), ("rk4", rk4())] {
         c.bench_function(&format!("step/{}/{name}", M::NAME), |b| {

@@ -5,7 +5,7 @@
 
 use dalembert::models::{Chain4, Chain4Symbolic};
 use dalembert::models::{chain_4, chain_4_symbolic};
-use dalembert::runtime::Model;
+use dalembert::runtime::prelude::*;
 
 mod common;
 use common::lcg;

@@ -10,8 +10,9 @@
 
 use dalembert::for_each_model;
 use dalembert::models::*;
+use dalembert::runtime::Rows;
 use dalembert::runtime::linalg::{kinetic_energy, mat_mul, mat_vec, projector};
-use dalembert::runtime::{Model, Rows};
+use dalembert::runtime::prelude::*;
 
 mod common;
 use common::{for_random_cases, onto_kernel};
@@ -29,7 +30,7 @@ fn max_abs<const N: usize>(m: &[[f64; N]; N]) -> f64 {
 }
 
 /// Checks every invariant for one model instance at (q, v).
-fn check<M: Model<Q, N>, const Q: usize, const N: usize>(
+fn check<M: Walls<Q, N>, const Q: usize, const N: usize>(
     model: &M,
     q: &[f64; Q],
     v: [f64; N],
@@ -85,25 +86,6 @@ fn check<M: Model<Q, N>, const Q: usize, const N: usize>(
             "{} {name}: normal velocity ≠ B's first row · v",
             M::NAME
         );
-        // vᵀ∇²f v is the rate of df along v, times v.
-        if Q == N {
-            let eps = 1e-5;
-            let shifted = |sign: f64| {
-                let qs: [f64; Q] = core::array::from_fn(|i| q[i] + sign * eps * v[i]);
-                model.normal(wall, &qs)
-            };
-            let (ahead, behind) = (shifted(1.0), shifted(-1.0));
-            let difference: f64 =
-                (0..N).map(|j| (ahead[j] - behind[j]) * v[j]).sum::<f64>() / (2.0 * eps);
-            let hessian = model.surface_hessian(wall, q, &v);
-            let vmax = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-            prop_assert!(
-                hessian
-                    .is_some_and(|h| (h - difference).abs() <= 1e-5 * (1.0 + size * vmax * vmax)),
-                "{} {name}: vᵀ∇²f v = {hessian:?}, a central difference gives {difference}",
-                M::NAME
-            );
-        }
         // AP = A and BP = B
         for (what, rows) in [("A", &a), ("B", &b)] {
             for row in rows.as_slice() {
@@ -183,16 +165,53 @@ fn check<M: Model<Q, N>, const Q: usize, const N: usize>(
     Ok(())
 }
 
+/// The emitted vᵀ∇²f v of every wall is the rate of df along v, times v
+/// (a central difference), in a model with coordinates.
+fn check_hessian<M: Surfaces<N>, const N: usize>(
+    model: &M,
+    q: &[f64; N],
+    v: [f64; N],
+) -> Result<(), TestCaseError> {
+    for &wall in M::WALLS {
+        let name = M::wall_name(wall);
+        let row = model.normal(wall, q);
+        let size = row.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let eps = 1e-5;
+        let shifted = |sign: f64| {
+            let qs: [f64; N] = core::array::from_fn(|i| q[i] + sign * eps * v[i]);
+            model.normal(wall, &qs)
+        };
+        let (ahead, behind) = (shifted(1.0), shifted(-1.0));
+        let difference: f64 =
+            (0..N).map(|j| (ahead[j] - behind[j]) * v[j]).sum::<f64>() / (2.0 * eps);
+        let hessian = model.surface_hessian(wall, q, &v);
+        let vmax = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        prop_assert!(
+            hessian.is_some_and(|h| (h - difference).abs() <= 1e-5 * (1.0 + size * vmax * vmax)),
+            "{} {name}: vᵀ∇²f v = {hessian:?}, a central difference gives {difference}",
+            M::NAME
+        );
+    }
+    Ok(())
+}
+
 /// 512 random cases (see `common::for_random_cases`).
-fn run<M: Model<Q, N>, const Q: usize, const N: usize>() {
+fn run<M: Walls<Q, N>, const Q: usize, const N: usize>() {
     for_random_cases::<M, Q, N>(512, check);
 }
 
 macro_rules! invariant_test {
+    ($module:ident, $ty:ident, 0, $n:literal) => {
+        #[test]
+        fn $module() {
+            run::<$ty, 0, $n>();
+        }
+    };
     ($module:ident, $ty:ident, $q:literal, $n:literal) => {
         #[test]
         fn $module() {
             run::<$ty, $q, $n>();
+            for_random_cases::<$ty, $n, $n>(512, check_hessian);
         }
     };
 }
@@ -205,9 +224,7 @@ struct Reversing(BallFloor);
 
 impl Model<0, 6> for Reversing {
     type Params = ball_floor::Params;
-    type Wall = ball_floor::Wall;
     const NAME: &'static str = "reversing";
-    const WALLS: &'static [ball_floor::Wall] = BallFloor::WALLS;
     const COORDINATES: &'static [&'static str] = &[];
     const VELOCITIES: &'static [&'static str] = BallFloor::VELOCITIES;
     const PARAMETERS: &'static [&'static str] = BallFloor::PARAMETERS;
@@ -223,35 +240,28 @@ impl Model<0, 6> for Reversing {
     fn set_parameter(&mut self, i: usize, x: f64) -> bool {
         self.0.set_parameter(i, x)
     }
-    fn wall_name(w: Self::Wall) -> &'static str {
-        BallFloor::wall_name(w)
-    }
     fn mass_matrix(&self, q: &[f64; 0]) -> [[f64; 6]; 6] {
         self.0.mass_matrix(q)
     }
     fn kinetic_energy(&self, q: &[f64; 0], v: &[f64; 6]) -> f64 {
         self.0.kinetic_energy(q, v)
     }
-    fn potential(&self, q: &[f64; 0]) -> f64 {
-        self.0.potential(q)
-    }
     fn constraints(&self, q: &[f64; 0]) -> Rows<6> {
         self.0.constraints(q)
     }
-    fn forcing(&self, q: &[f64; 0], v: &[f64; 6]) -> [f64; 6] {
-        self.0.forcing(q, v)
-    }
-    fn constraint_drift(&self, q: &[f64; 0], v: &[f64; 6]) -> [f64; 6] {
-        self.0.constraint_drift(q, v)
-    }
-    fn surface(&self, w: Self::Wall, q: &[f64; 0]) -> f64 {
-        Model::surface(&self.0, w, q)
+}
+
+impl Walls<0, 6> for Reversing {
+    type Wall = ball_floor::Wall;
+    const WALLS: &'static [ball_floor::Wall] = BallFloor::WALLS;
+    fn wall_name(w: Self::Wall) -> &'static str {
+        BallFloor::wall_name(w)
     }
     fn wall_rows(&self, w: Self::Wall, q: &[f64; 0]) -> Rows<6> {
         self.0.wall_rows(w, q)
     }
     fn projector(&self, w: Self::Wall, q: &[f64; 0]) -> [[f64; 6]; 6] {
-        Model::projector(&self.0, w, q)
+        Walls::projector(&self.0, w, q)
     }
     fn collide(&self, _: Self::Wall, _: &[f64; 0], v: &[f64; 6]) -> [f64; 6] {
         v.map(|x| -x)

@@ -6,8 +6,8 @@ use std::cell::Cell;
 
 use dalembert::for_each_model;
 use dalembert::models::*;
-use dalembert::runtime::Model;
 use dalembert::runtime::linalg::projector;
+use dalembert::runtime::prelude::*;
 
 struct Counting;
 
@@ -38,17 +38,16 @@ fn allocations_during(f: impl FnOnce()) -> usize {
     ALLOCATIONS.with(Cell::get) - before
 }
 
-/// Calls every function of the model's trait (and the runtime's generic
-/// projector) and returns a checksum so nothing is optimised away.
-fn exercise<M: Model<Q, N>, const Q: usize, const N: usize>(m: &M) -> f64 {
+/// Calls every function of the `Model` and `Walls` traits (and the
+/// runtime's generic projector) and returns a checksum so nothing is
+/// optimised away.
+fn exercise<M: Walls<Q, N>, const Q: usize, const N: usize>(m: &M) -> f64 {
     let q: [f64; Q] = std::array::from_fn(|i| 0.4 + 0.1 * i as f64);
     let v: [f64; N] = std::array::from_fn(|i| 0.3 - 0.2 * i as f64);
-    let mut s = m.energy(&q, &v) + m.mass_matrix(&q)[0][0];
+    let mut s = m.kinetic_energy(&q, &v) + m.mass_matrix(&q)[0][0];
     s += m.constraints(&q).apply(&v).max_abs();
-    s += m.forcing(&q, &v)[0] + m.constraint_drift(&q, &v)[0];
-    s += m.holonomic(&q).max_abs();
     for &w in M::WALLS {
-        s += m.surface(w, &q);
+        s += m.normal(w, &q)[0];
         s += m.wall_rows(w, &q).as_slice().len() as f64;
         s += m.projector(w, &q)[0][0];
         s += m.collide(w, &q, &v)[0];
@@ -61,13 +60,46 @@ fn exercise<M: Model<Q, N>, const Q: usize, const N: usize>(m: &M) -> f64 {
     s
 }
 
+/// The `Dynamics` and `Surfaces` functions of a model with coordinates,
+/// the closed-form and numeric q̈ included.
+fn exercise_motion<M: Surfaces<N>, const N: usize>(m: &M) -> f64 {
+    let q: [f64; N] = std::array::from_fn(|i| 0.4 + 0.1 * i as f64);
+    let v: [f64; N] = std::array::from_fn(|i| 0.3 - 0.2 * i as f64);
+    let mut s = m.energy(&q, &v);
+    s += m.forcing(&q, &v)[0] + m.constraint_drift(&q, &v)[0];
+    s += m.holonomic(&q).max_abs();
+    if let Some(x) = m.closed_form_accelerations(&q, &v) {
+        s += x[0];
+    }
+    if let Ok(a) = dalembert::runtime::dynamics::accelerations(m, &q, &v) {
+        s += a.qdd[0];
+    }
+    for &w in M::WALLS {
+        s += m.surface(w, &q);
+        s += m.surface_hessian(w, &q, &v).unwrap_or(0.0);
+    }
+    s
+}
+
 macro_rules! no_alloc_test {
+    ($module:ident, $ty:ident, 0, $n:literal) => {
+        #[test]
+        fn $module() {
+            let model = <$ty as Model<0, $n>>::with_params(Default::default());
+            let mut sum = 0.0;
+            let n = allocations_during(|| sum = exercise::<$ty, 0, $n>(&model));
+            assert!(sum.is_finite());
+            assert_eq!(n, 0, "{} allocated {n} times", stringify!($ty));
+        }
+    };
     ($module:ident, $ty:ident, $q:literal, $n:literal) => {
         #[test]
         fn $module() {
             let model = <$ty as Model<$q, $n>>::with_params(Default::default());
             let mut sum = 0.0;
-            let n = allocations_during(|| sum = exercise::<$ty, $q, $n>(&model));
+            let n = allocations_during(|| {
+                sum = exercise::<$ty, $q, $n>(&model) + exercise_motion::<$ty, $n>(&model)
+            });
             assert!(sum.is_finite());
             assert_eq!(n, 0, "{} allocated {n} times", stringify!($ty));
         }
@@ -81,13 +113,13 @@ for_each_model!(no_alloc_test);
 /// projection) against its wall.
 #[test]
 fn simulator_does_not_allocate() {
-    use dalembert::runtime::simulate::{Integrator, Settings, Simulator, State};
+    use dalembert::runtime::simulate::{Integrator, Rk4, Settings, Simulator, State};
     let ball = BallBounce::default();
     let r = ball.params.r;
     let q = [0.0, 0.0, r + 1.0, 0.0, std::f64::consts::FRAC_PI_2, 0.0];
     let v = [1.0, 0.0, 0.0, 0.0, 0.0, -5.0];
     let rk4 = Settings {
-        integrator: Integrator::Rk4 { step: 1e-3 },
+        integrator: Integrator::Rk4(Rk4 { step: 1e-3 }),
         ..Settings::default()
     };
     for settings in [Settings::default(), rk4] {

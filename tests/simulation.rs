@@ -8,9 +8,11 @@
 //! than resolved.
 
 use dalembert::models::{BallBounce, BallWallEuler, Chain3, MassesOnLine, PendulumWall};
-use dalembert::runtime::Model;
 use dalembert::runtime::dynamics::DynamicsError;
-use dalembert::runtime::simulate::{Integrator, Settings, SimError, Simulator, State, admissible};
+use dalembert::runtime::prelude::*;
+use dalembert::runtime::simulate::{
+    DormandPrince, Integrator, Rk4, Settings, SimError, Simulator, State, admissible,
+};
 
 // ------------------------------------------------------------ helpers
 
@@ -42,17 +44,17 @@ fn pendulum_time(l: f64, g: f64, theta0: f64, theta: f64) -> f64 {
 
 fn dormand_prince(rtol: f64) -> Settings {
     Settings {
-        integrator: Integrator::DormandPrince {
+        integrator: Integrator::DormandPrince(DormandPrince {
             rtol,
             atol: rtol * 1e-2,
             max_step: f64::INFINITY,
-        },
+        }),
         ..Settings::default()
     }
 }
 
 /// The model file's initial state.
-fn initial<M: Model<N, N>, const N: usize>() -> State<N> {
+fn initial<M: Dynamics<N>, const N: usize>() -> State<N> {
     State {
         t: 0.0,
         q: M::INITIAL_COORDINATES,
@@ -88,7 +90,7 @@ fn free_pendulum_has_the_elliptic_period() {
         (dormand_prince(1e-12), 1e-9),
         (
             Settings {
-                integrator: Integrator::Rk4 { step: 1e-3 },
+                integrator: Integrator::Rk4(Rk4 { step: 1e-3 }),
                 ..Settings::default()
             },
             1e-9,
@@ -268,7 +270,7 @@ fn aimed_steps_find_the_collisions_fixed_steps_find() {
     };
     let adaptive = collisions(dormand_prince(1e-11));
     let fixed = collisions(Settings {
-        integrator: Integrator::Rk4 { step: 1e-4 },
+        integrator: Integrator::Rk4(Rk4 { step: 1e-4 }),
         ..Settings::default()
     });
     eprintln!("{} collisions", adaptive.len());
@@ -544,7 +546,7 @@ fn bad_states_are_typed_errors() {
     assert!(matches!(bad, Err(SimError::Inadmissible { .. })));
     // A bad setting.
     let rk0 = Settings {
-        integrator: Integrator::Rk4 { step: 0.0 },
+        integrator: Integrator::Rk4(Rk4 { step: 0.0 }),
         ..Settings::default()
     };
     assert!(matches!(

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use dalembert::models::{BallFloor, BallWallEuler};
-use dalembert::runtime::Model;
+use dalembert::runtime::prelude::*;
 use dalembert_example_vendored::single;
 
 mod common;
@@ -24,7 +24,7 @@ fn check_current(model: &str, vendored: &str, f32: bool) {
     let flag = if f32 { " --f32" } else { "" };
     assert!(
         fresh == copy,
-        "{vendored} is stale: regenerate it with\n  cargo run --release -- generate models/{model}{flag} -o {vendored}"
+        "{vendored} is stale: regenerate it with\n  cargo run --release -p dalembert-cli -- generate models/{model}{flag} -o {vendored}"
     );
 }
 

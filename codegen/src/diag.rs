@@ -196,6 +196,12 @@ impl miette::Diagnostic for Rendered {
     }
 }
 
+/// Proof that an error was recorded. Only [`Collector::error`] makes one, so
+/// a stage that fails with `Err(Reported)` has always said why: a failure
+/// with no diagnostic cannot be written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Reported(());
+
 /// Collects errors for one file (the `Ctxt` pattern): every stage adds what it
 /// finds and the caller decides at the end whether to go on.
 #[derive(Debug)]
@@ -215,8 +221,9 @@ impl Collector {
         }
     }
 
-    /// Records an error at `span`.
-    pub fn error(&mut self, kind: ErrorKind, span: Option<Range<usize>>) {
+    /// Records an error at `span` (the proof that it was recorded is
+    /// returned, for stages that stop here).
+    pub fn error(&mut self, kind: ErrorKind, span: Option<Range<usize>>) -> Reported {
         let (line, col) = span
             .as_ref()
             .map(|s| line_col(&self.source, s.start))
@@ -227,6 +234,7 @@ impl Collector {
             line,
             col,
         });
+        Reported(())
     }
 
     /// Whether anything was recorded.
@@ -236,10 +244,16 @@ impl Collector {
 
     /// `Err` with everything recorded, or `Ok(value)` when nothing was.
     pub fn finish<T>(self, value: T) -> Result<T, ModelErrors> {
-        if self.errors.is_empty() {
-            Ok(value)
-        } else {
-            Err(self.into_errors())
+        self.conclude(Ok(value))
+    }
+
+    /// The end of a stage: `Ok` when it succeeded and nothing was recorded,
+    /// else everything recorded, which is never empty (a failure carries a
+    /// [`Reported`]).
+    pub fn conclude<T>(self, result: Result<T, Reported>) -> Result<T, ModelErrors> {
+        match result {
+            Ok(value) if self.errors.is_empty() => Ok(value),
+            _ => Err(self.into_errors()),
         }
     }
 

@@ -4,62 +4,80 @@
 //!
 //! 1. [`ir`]: the model file (TOML) to a validated [`ir::Model`], every error
 //!    collected with file:line:col;
-//! 2. [`symbolic`]: G, A, each wall's B, P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B and the
-//!    collision map (I − 2P)v, derived exactly, the paper's hypotheses checked,
-//!    and each emitted function optimised into straight-line instructions
-//!    ([`program::Program`]);
-//! 3. [`emit`]: Rust tokens for the model, formatted with prettyplease.
+//! 2. [`mod@derive`]: G, A, each wall's B, P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B and the
+//!    collision map (I − 2P)v, derived exactly in named passes, the paper's
+//!    hypotheses checked, and each emitted function optimised into a
+//!    straight-line [`program::Program`]; the result is plain data;
+//! 3. [`emit`]: Rust tokens for the model, formatted with prettyplease, for
+//!    the [`emit::Options`] asked for (f64 or f32).
+//!
+//! Between the stages: [`quantity`], the table of emitted functions that
+//! stages 2 and 3 share, [`program`] and [`diag`]. No stage imports a later
+//! one.
 //!
 //! Front ends: [`compile_dir`] for build scripts (see the workspace's
-//! `build.rs`), [`generate`] and [`derive`] for the CLI and for tests.
+//! `build.rs`), [`generate`] and [`fn@derive`] for the CLI and for tests.
 //!
-//! The symbolic engine (symbolica) is used only inside [`symbolic`], only at
+//! The symbolic engine (symbolica) is used only inside [`mod@derive`], only at
 //! build time, and only by one thread of one process at a time ([`lock`]).
 
+pub mod derive;
 pub mod diag;
 pub mod emit;
 pub mod ir;
 pub mod lock;
 pub mod program;
+pub mod quantity;
 pub mod reference;
-pub mod symbolic;
 
 use std::path::{Path, PathBuf};
 
+pub use derive::Derivation;
 pub use diag::{Diagnostic, ErrorKind, ModelErrors};
-pub use symbolic::Derivation;
+pub use emit::{Options, Scalar};
 
 /// Validates and derives the model in `path`.
 pub fn derive(path: &Path) -> Result<Derivation, ModelErrors> {
     let model = ir::load(path)?;
-    symbolic::derive(&model)
+    derive::derive(&model)
 }
 
-/// The formatted Rust source for the model in `path`.
+/// The formatted Rust source for the model in `path` (f64).
 pub fn generate(path: &Path) -> Result<String, ModelErrors> {
-    let d = derive(path)?;
-    Ok(emit::file(&d))
+    generate_with(path, Options::default())
 }
 
-/// The formatted Rust source for the model in `path` with `f32` arithmetic
-/// (for microcontrollers without double-precision hardware): the model's
-/// inherent functions, without the f64 `Model` trait. Every wall needs a
-/// closed-form P (structured evaluation uses the runtime's f64 numerics).
-pub fn generate_f32(path: &Path) -> Result<String, ModelErrors> {
-    let mut d = derive(path)?;
-    if let Some(w) = d.walls.iter().find(|w| w.structured) {
+/// The formatted Rust source for the model in `path`, emitted as `options`
+/// say. f32 needs a closed-form P for every wall (structured evaluation
+/// uses the runtime's f64 numerics).
+pub fn generate_with(path: &Path, options: Options) -> Result<String, ModelErrors> {
+    let d = derive(path)?;
+    if options.scalar == Scalar::F32
+        && let Some(w) = d.walls.iter().find(|w| w.structured())
+    {
         let mut cx = diag::Collector::new(&d.model.file, &d.model.source);
-        cx.error(
+        let e = cx.error(
             ErrorKind::Structure(format!(
                 "f32 generation needs a closed-form P, and wall `{}` is structured: set `projector = \"symbolic\"` under [model]",
                 w.name
             )),
             None,
         );
-        return Err(cx.into_errors());
+        return cx.conclude(Err(e));
     }
-    d.scalar = emit::Scalar::F32;
-    Ok(emit::file(&d))
+    Ok(emit::file(&d, options))
+}
+
+/// The formatted Rust source for the model in `path` with `f32` arithmetic
+/// (for microcontrollers without double-precision hardware): the model's
+/// inherent functions, without the f64 `Model` trait.
+pub fn generate_f32(path: &Path) -> Result<String, ModelErrors> {
+    generate_with(
+        path,
+        Options {
+            scalar: Scalar::F32,
+        },
+    )
 }
 
 /// One model's generated file and what it took to make it.
@@ -99,7 +117,7 @@ pub fn compile_dir(models_dir: &Path, out_dir: &Path) -> Result<Vec<Generated>, 
         match derive(&file) {
             Ok(d) => {
                 let rust_file = out_dir.join(format!("{}.rs", d.model.name));
-                if let Err(e) = std::fs::write(&rust_file, emit::file(&d)) {
+                if let Err(e) = std::fs::write(&rust_file, emit::file(&d, Options::default())) {
                     let mut cx = diag::Collector::new(&file, "");
                     cx.error(ErrorKind::Io(format!("{}: {e}", rust_file.display())), None);
                     errors.push(cx.into_errors());

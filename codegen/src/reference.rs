@@ -13,7 +13,8 @@ use std::path::Path;
 use indexmap::IndexMap;
 use serde::Deserialize;
 
-use crate::symbolic::{self, Derivation};
+use crate::derive::inspect as symbolic;
+use crate::derive::{Derivation, Projection};
 
 /// A reference read from a file.
 #[derive(Debug, Clone, Deserialize)]
@@ -78,18 +79,23 @@ impl Reference {
     }
 
     /// Compares with `d`.
+    #[allow(clippy::needless_range_loop)] // matrix code reads best with indices
     pub fn compare(&self, d: &Derivation) -> Result<Comparison, String> {
         let wall = d
             .walls
             .iter()
             .find(|w| w.name == self.wall)
             .ok_or_else(|| format!("model `{}` has no wall `{}`", d.model.name, self.wall))?;
-        if wall.structured {
+        let Projection::ClosedForm {
+            projector: derived_p,
+            collision: derived_law,
+        } = &wall.projection
+        else {
             return Err(format!(
                 "wall `{}` of `{}` has no closed-form P (structured evaluation): set `projector = \"symbolic\"` under [model]",
                 self.wall, d.model.name
             ));
-        }
+        };
         let n = d.model.velocities.len();
         if self.projector.len() != n || self.projector.iter().any(|r| r.len() != n) {
             return Err(format!("the reference P must be {n}×{n}"));
@@ -98,12 +104,12 @@ impl Reference {
         for i in 0..n {
             for j in 0..n {
                 let reference = self.entry(i, j);
-                if !symbolic::same(&reference, &wall.projector[i][j])? {
+                if !symbolic::same(&reference, &derived_p[i][j])? {
                     projector.push(Difference {
                         row: i,
                         col: j,
                         reference,
-                        derived: wall.projector[i][j].clone(),
+                        derived: derived_p[i][j].clone(),
                     });
                 }
             }
@@ -120,7 +126,7 @@ impl Reference {
                 .iter()
                 .map(|(k, v)| (k.as_str(), v.as_str()))
                 .collect();
-            for (i, (r, c)) in self.collision.iter().zip(&wall.collision).enumerate() {
+            for (i, (r, c)) in self.collision.iter().zip(derived_law).enumerate() {
                 let r_sub = symbolic::substitute(r, &subs)?;
                 let c_sub = symbolic::substitute(c, &subs)?;
                 if !symbolic::same(&r_sub, &c_sub)? {

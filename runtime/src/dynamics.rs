@@ -7,8 +7,8 @@
 //! z = −G⁻¹h and Y = G⁻¹Aᵀ, λ solves (A Y) λ = −Ȧq̇ − A z and q̈ = z + Y λ
 //! (both systems by Cholesky factorisation on fixed-size arrays).
 
-use crate::Model;
-use crate::linalg::{Cholesky, dot};
+use crate::Dynamics;
+use crate::linalg::{Cholesky, constrained_solve, dot};
 
 /// Why the accelerations could not be computed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -38,10 +38,10 @@ fn finite<const N: usize>(x: &[f64; N]) -> bool {
 }
 
 /// q̈ of model `m` at (q, q̇): the generated closed form
-/// ([`Model::closed_form_accelerations`]) where the model has one and it is
+/// ([`Dynamics::closed_form_accelerations`]) where the model has one and it is
 /// finite there, else the numeric solve of [`accelerations`] (which also
 /// tells why a state has none). `q̇` should satisfy A q̇ = 0.
-pub fn qdd<M: Model<N, N>, const N: usize>(
+pub fn qdd<M: Dynamics<N>, const N: usize>(
     m: &M,
     q: &[f64; N],
     qd: &[f64; N],
@@ -54,7 +54,7 @@ pub fn qdd<M: Model<N, N>, const N: usize>(
 
 /// q̈ and λ of model `m` at (q, q̇) by solving the equations numerically
 /// (Cholesky factorisations of G and A G⁻¹Aᵀ). `q̇` should satisfy A q̇ = 0.
-pub fn accelerations<M: Model<N, N>, const N: usize>(
+pub fn accelerations<M: Dynamics<N>, const N: usize>(
     m: &M,
     q: &[f64; N],
     qd: &[f64; N],
@@ -79,31 +79,14 @@ pub fn accelerations<M: Model<N, N>, const N: usize>(
             constraints: 0,
         });
     }
-    // Y's columns G⁻¹aᵣᵀ, then the k×k system (A Y) λ = −Ȧq̇ − A z.
+    // The k×k system (A G⁻¹Aᵀ) λ = −Ȧq̇ − A z, then q̈ = z + G⁻¹Aᵀλ.
     let rows = a.as_slice();
-    let mut y = [[0.0; N]; N];
-    for (yr, row) in y.iter_mut().zip(rows) {
-        *yr = chol.solve(row);
-    }
-    let mut s = [[0.0; N]; N];
     let mut rhs = [0.0; N];
     for (r, row) in rows.iter().enumerate() {
-        for t in 0..k {
-            s[r][t] = dot(row, &y[t]);
-        }
         rhs[r] = -c[r] - dot(row, &z);
     }
-    // A G⁻¹Aᵀ is symmetric, and positive definite exactly when A's rows
-    // are independent.
-    let lambda = Cholesky::new(&s, k)
-        .ok_or(DynamicsError::DependentConstraints)?
-        .solve(&rhs);
-    let mut qdd = z;
-    for (yr, l) in y[..k].iter().zip(&lambda) {
-        for (q, yi) in qdd.iter_mut().zip(yr) {
-            *q += l * yi;
-        }
-    }
+    let (qdd, lambda) =
+        constrained_solve(&chol, rows, &rhs[..k], z).ok_or(DynamicsError::DependentConstraints)?;
     let out = Accelerations {
         qdd,
         lambda,

@@ -1,10 +1,11 @@
-//! Small fixed-size linear algebra, without heap allocation.
+//! Small fixed-size linear algebra, without heap allocation: one Cholesky
+//! factorisation and one constrained solve ([`constrained_solve`]) that the
+//! equations of motion, the projections onto the constraints and the
+//! structured collision maps share.
 //!
 //! [`projector`] computes P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B numerically from G and the rows
-//! of B. Generated models evaluate P from its symbolic form instead; this is
-//! the generic path (and an independent check of the generated one).
-
-use nalgebra::SMatrix;
+//! of B. Generated models evaluate P from its symbolic form where they can;
+//! this is the generic path (and an independent check of the generated one).
 
 /// Euclidean dot product.
 pub fn dot<const N: usize>(a: &[f64; N], b: &[f64; N]) -> f64 {
@@ -39,11 +40,9 @@ pub fn kinetic_energy<const N: usize>(g: &[[f64; N]; N], v: &[f64; N]) -> f64 {
 /// The Cholesky factor L (G = L Lᵀ) of the leading `n`×`n` block of a
 /// symmetric positive definite matrix, on fixed-size arrays.
 ///
-/// The numeric solve of the equations of motion (for models without a
-/// closed-form q̈) and structured collision maps use it; on the 6×6 mass
-/// matrix of the ball in flight it was several times faster than nalgebra's
-/// general-purpose static Cholesky (measured with `cargo bench --bench
-/// simulate`, see docs/performance.md).
+/// Every solve of the runtime uses it: the equations of motion (for models
+/// without a closed-form q̈), projections onto the constraints and
+/// structured collision maps.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Cholesky<const N: usize> {
     l: [[f64; N]; N],
@@ -79,11 +78,23 @@ impl<const N: usize> Cholesky<N> {
 
     /// x with A x = b on the leading block (entries past it are zero).
     pub fn solve(&self, b: &[f64; N]) -> [f64; N] {
+        self.solve_upper(&self.solve_lower(b))
+    }
+
+    /// y with L y = b (forward substitution).
+    pub fn solve_lower(&self, b: &[f64; N]) -> [f64; N] {
         let (l, n) = (&self.l, self.n);
         let mut y = [0.0; N];
         for i in 0..n {
             y[i] = (b[i] - dot_prefix(&l[i], &y, i)) * self.inv[i];
         }
+        y
+    }
+
+    /// x with Lᵀ x = y (back substitution).
+    pub fn solve_upper(&self, y: &[f64; N]) -> [f64; N] {
+        let (l, n) = (&self.l, self.n);
+        let mut y = *y;
         for i in (0..n).rev() {
             let mut sum = y[i];
             for k in i + 1..n {
@@ -118,6 +129,7 @@ pub enum ProjectorError {
 /// onto the row space of C) Lᵀ. The row space is spanned by Gram–Schmidt,
 /// so rows of B that depend on earlier ones (relative size below `1e-12`)
 /// are ignored rather than making BG⁻¹Bᵀ singular.
+#[allow(clippy::needless_range_loop)] // matrix code reads best with indices
 pub fn projector<const N: usize>(
     g: &[[f64; N]; N],
     b_rows: &[[f64; N]],
@@ -126,21 +138,13 @@ pub fn projector<const N: usize>(
     if !g.iter().all(finite) || !b_rows.iter().all(finite) {
         return Err(ProjectorError::NonFinite);
     }
-    let gm = SMatrix::<f64, N, N>::from_fn(|i, j| g[i][j]);
-    let chol = gm
-        .cholesky()
-        .ok_or(ProjectorError::MassMatrixNotPositiveDefinite)?;
-    let l = chol.l();
+    let chol = Cholesky::new(g, N).ok_or(ProjectorError::MassMatrixNotPositiveDefinite)?;
     // Orthonormal basis of the row space of C = B L⁻ᵀ, i.e. of the columns
     // of L⁻¹ Bᵀ.
     let mut basis = [[0.0; N]; N];
     let mut rank = 0;
     for row in b_rows {
-        let bt = nalgebra::SVector::<f64, N>::from_fn(|i, _| row[i]);
-        let Some(c) = l.solve_lower_triangular(&bt) else {
-            return Err(ProjectorError::MassMatrixNotPositiveDefinite);
-        };
-        let mut c: [f64; N] = core::array::from_fn(|i| c[i]);
+        let mut c = chol.solve_lower(row);
         let size = libm::sqrt(dot(&c, &c));
         for e in &basis[..rank] {
             let k = dot(e, &c);
@@ -154,26 +158,67 @@ pub fn projector<const N: usize>(
             rank += 1;
         }
     }
-    // P_w = Σ e eᵀ; P = L⁻ᵀ P_w Lᵀ.
-    let mut pw = SMatrix::<f64, N, N>::zeros();
-    for e in &basis[..rank] {
-        let ev = nalgebra::SVector::<f64, N>::from_fn(|i, _| e[i]);
-        pw += ev * ev.transpose();
+    // P_w = Σ e eᵀ; column j of P is L⁻ᵀ (P_w Lᵀ)ⱼ, and (Lᵀ)ₖⱼ = Lⱼₖ.
+    let mut p = [[0.0; N]; N];
+    for j in 0..N {
+        let lt_col: [f64; N] = core::array::from_fn(|k| chol.l[j][k]);
+        let mut col = [0.0; N];
+        for e in &basis[..rank] {
+            let k = dot(e, &lt_col);
+            for (ci, ei) in col.iter_mut().zip(e) {
+                *ci += k * ei;
+            }
+        }
+        let x = chol.solve_upper(&col);
+        for (i, xi) in x.iter().enumerate() {
+            p[i][j] = *xi;
+        }
     }
-    let lt = l.transpose();
-    let p_lt = pw * lt;
-    let Some(p) = lt.solve_upper_triangular(&p_lt) else {
-        return Err(ProjectorError::MassMatrixNotPositiveDefinite);
-    };
-    Ok(core::array::from_fn(|i| {
-        core::array::from_fn(|j| p[(i, j)])
-    }))
+    if p.iter().all(finite) {
+        Ok(p)
+    } else {
+        Err(ProjectorError::MassMatrixNotPositiveDefinite)
+    }
 }
 
 /// The collision map v⁺ = (I − 2P) v.
 pub fn reflect<const N: usize>(p: &[[f64; N]; N], v: &[f64; N]) -> [f64; N] {
     let pv = mat_vec(p, v);
     core::array::from_fn(|i| v[i] - 2.0 * pv[i])
+}
+
+/// The constrained solve: with G = L Lᵀ and the rows R (k of them),
+/// Y = G⁻¹Rᵀ and the k×k system (R Y) μ = `rhs`, returns `base` + Y μ and
+/// μ. R G⁻¹ Rᵀ is symmetric, and positive definite exactly when R's rows are
+/// independent: `None` otherwise. The equations of motion (μ = λ, base =
+/// −G⁻¹h) and [`correction`] (base = 0) are both this solve.
+pub fn constrained_solve<const N: usize>(
+    chol: &Cholesky<N>,
+    rows: &[[f64; N]],
+    rhs: &[f64],
+    base: [f64; N],
+) -> Option<([f64; N], [f64; N])> {
+    let k = rows.len().min(rhs.len()).min(N);
+    let mut y = [[0.0; N]; N];
+    for (c, row) in rows[..k].iter().enumerate() {
+        y[c] = chol.solve(row);
+    }
+    let mut s = [[0.0; N]; N];
+    let mut b = [0.0; N];
+    for a in 0..k {
+        for c in 0..k {
+            s[a][c] = dot(&rows[a], &y[c]);
+        }
+        b[a] = rhs[a];
+    }
+    let mu = Cholesky::new(&s, k)?.solve(&b);
+    let mut out = base;
+    for (c, yc) in y[..k].iter().enumerate() {
+        for (o, yi) in out.iter_mut().zip(yc) {
+            *o += mu[c] * yi;
+        }
+    }
+    Some((out, mu))
 }
 
 /// The smallest correction in the metric of G that removes the residuals
@@ -190,30 +235,9 @@ pub fn correction<const N: usize>(
     if !g.iter().all(|row| finite(row)) || !rows.iter().all(|row| finite(row)) || !finite(r) {
         return Err(ProjectorError::NonFinite);
     }
-    let k = rows.len().min(r.len()).min(N);
     let chol = Cholesky::new(g, N).ok_or(ProjectorError::MassMatrixNotPositiveDefinite)?;
-    // Y's columns G⁻¹Rᵀ, then the k×k system (R Y) μ = r.
-    let mut y = [[0.0; N]; N];
-    for (c, row) in rows[..k].iter().enumerate() {
-        y[c] = chol.solve(row);
-    }
-    let mut s = [[0.0; N]; N];
-    let mut rhs = [0.0; N];
-    for a in 0..k {
-        for b in 0..k {
-            s[a][b] = dot(&rows[a], &y[b]);
-        }
-        rhs[a] = r[a];
-    }
-    let mu = Cholesky::new(&s, k)
-        .ok_or(ProjectorError::DependentRows)?
-        .solve(&rhs);
-    let mut delta = [0.0; N];
-    for (c, yc) in y[..k].iter().enumerate() {
-        for (d, yi) in delta.iter_mut().zip(yc) {
-            *d += mu[c] * yi;
-        }
-    }
+    let (delta, _) =
+        constrained_solve(&chol, rows, r, [0.0; N]).ok_or(ProjectorError::DependentRows)?;
     if finite(&delta) {
         Ok(delta)
     } else {

@@ -9,15 +9,9 @@
 // Operation counts (f64):
 //   mass_matrix                  0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   kinetic_energy               5 add, 9 mul, 0 div, 0 fn (14 in all)
-//   potential                    0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   constraints                  0 add, 0 mul, 0 div, 0 fn (0 in all)
-//   holonomic                    0 add, 0 mul, 0 div, 0 fn (0 in all)
-//   forcing                      0 add, 0 mul, 0 div, 0 fn (0 in all)
-//   constraint_drift             0 add, 0 mul, 0 div, 0 fn (0 in all)
-//   floor_surface                0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_normal                 0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_normal_velocity        0 add, 0 mul, 0 div, 0 fn (0 in all)
-//   floor_surface_hessian        0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_b_rows                 0 add, 1 mul, 0 div, 0 fn (1 in all)
 //   floor_projector              1 add, 10 mul, 1 div, 0 fn (12 in all)
 //   floor_collide                8 add, 19 mul, 1 div, 0 fn (28 in all)
@@ -150,13 +144,6 @@ impl BallFloor {
         let o0: f64 = 0.5f64 * t3;
         o0
     }
-    /// Potential energy V(q).
-    #[inline]
-    #[allow(unused_variables)]
-    pub fn potential(&self, q: &[f64; 0]) -> f64 {
-        let o0: f64 = 0f64;
-        o0
-    }
     /// Rows of A(q).
     #[inline]
     #[allow(unused_variables)]
@@ -172,37 +159,6 @@ impl BallFloor {
             ],
             0,
         )
-    }
-    /// The holonomic constraints h(q) (zero on the constraint manifold); their differentials are the first rows of A.
-    #[inline]
-    #[allow(unused_variables)]
-    pub fn holonomic(&self, q: &[f64; 0]) -> ::dalembert_runtime::Rows1<6> {
-        ::dalembert_runtime::Rows1::new([0.0, 0.0, 0.0, 0.0, 0.0, 0.0], 0)
-    }
-    /// h(q, q̇): the equations of motion are G(q) q̈ + h(q, q̇) = A(q)ᵀλ (zero for an instantaneous model).
-    #[inline]
-    #[allow(unused_variables)]
-    pub fn forcing(&self, q: &[f64; 0], v: &[f64; 6]) -> [f64; 6] {
-        let o0: f64 = 0f64;
-        let o1: f64 = 0f64;
-        let o2: f64 = 0f64;
-        let o3: f64 = 0f64;
-        let o4: f64 = 0f64;
-        let o5: f64 = 0f64;
-        [o0, o1, o2, o3, o4, o5]
-    }
-    /// Ȧq̇, one entry per row of A (the rest zero): A q̈ + Ȧq̇ = 0 along the motion.
-    #[inline]
-    #[allow(unused_variables)]
-    pub fn constraint_drift(&self, q: &[f64; 0], v: &[f64; 6]) -> [f64; 6] {
-        [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
-    }
-    /// Wall `floor`: the surface function f(q).
-    #[inline]
-    #[allow(unused_variables)]
-    pub fn floor_surface(&self, q: &[f64; 0]) -> f64 {
-        let o0: f64 = 0f64;
-        o0
     }
     /// Wall `floor`: its normal df(q), the first row of B.
     #[inline]
@@ -222,13 +178,6 @@ impl BallFloor {
     pub fn floor_normal_velocity(&self, q: &[f64; 0], v: &[f64; 6]) -> f64 {
         let i5: f64 = v[2];
         let o0: f64 = i5;
-        o0
-    }
-    /// Wall `floor`: vᵀ∇²f(q)v; along a motion f̈ = df(q)·q̈ + vᵀ∇²f(q)v.
-    #[inline]
-    #[allow(unused_variables)]
-    pub fn floor_surface_hessian(&self, q: &[f64; 0], v: &[f64; 6]) -> f64 {
-        let o0: f64 = 0f64;
         o0
     }
     /// Wall `floor`: the independent rows of B(q), the normal velocity first.
@@ -369,14 +318,10 @@ impl BallFloor {
 }
 impl ::dalembert_runtime::Model<0, 6> for BallFloor {
     type Params = Params;
-    type Wall = Wall;
     const NAME: &'static str = "ball_floor";
-    const WALLS: &'static [Wall] = &[Wall::Floor];
     const COORDINATES: &'static [&'static str] = &[];
     const VELOCITIES: &'static [&'static str] = &["v1", "v2", "v3", "w1", "w2", "w3"];
     const PARAMETERS: &'static [&'static str] = &["m", "r", "J"];
-    const INITIAL_COORDINATES: [f64; 0] = Self::INITIAL_COORDINATES;
-    const INITIAL_VELOCITIES: [f64; 6] = Self::INITIAL_VELOCITIES;
     fn with_params(params: Params) -> Self {
         Self { params }
     }
@@ -408,11 +353,6 @@ impl ::dalembert_runtime::Model<0, 6> for BallFloor {
             _ => false,
         }
     }
-    fn wall_name(wall: Wall) -> &'static str {
-        match wall {
-            Wall::Floor => "floor",
-        }
-    }
     #[inline]
     fn mass_matrix(&self, q: &[f64; 0]) -> [[f64; 6]; 6] {
         self.mass_matrix(q)
@@ -422,29 +362,28 @@ impl ::dalembert_runtime::Model<0, 6> for BallFloor {
         self.kinetic_energy(q, v)
     }
     #[inline]
-    fn potential(&self, q: &[f64; 0]) -> f64 {
-        self.potential(q)
-    }
-    #[inline]
     fn constraints(&self, q: &[f64; 0]) -> ::dalembert_runtime::Rows<6> {
         self.constraints(q)
     }
-    #[inline]
-    fn holonomic(&self, q: &[f64; 0]) -> ::dalembert_runtime::Rows1<6> {
-        self.holonomic(q)
-    }
-    #[inline]
-    fn forcing(&self, q: &[f64; 0], v: &[f64; 6]) -> [f64; 6] {
-        self.forcing(q, v)
-    }
-    #[inline]
-    fn constraint_drift(&self, q: &[f64; 0], v: &[f64; 6]) -> [f64; 6] {
-        self.constraint_drift(q, v)
-    }
-    #[inline]
-    fn surface(&self, wall: Wall, q: &[f64; 0]) -> f64 {
+}
+impl ::dalembert_runtime::Walls<0, 6> for BallFloor {
+    type Wall = Wall;
+    const WALLS: &'static [Wall] = &[Wall::Floor];
+    fn wall_name(wall: Wall) -> &'static str {
         match wall {
-            Wall::Floor => self.floor_surface(q),
+            Wall::Floor => "floor",
+        }
+    }
+    #[inline]
+    fn normal(&self, wall: Wall, q: &[f64; 0]) -> [f64; 6] {
+        match wall {
+            Wall::Floor => self.floor_normal(q),
+        }
+    }
+    #[inline]
+    fn normal_velocity(&self, wall: Wall, q: &[f64; 0], v: &[f64; 6]) -> f64 {
+        match wall {
+            Wall::Floor => self.floor_normal_velocity(q, v),
         }
     }
     #[inline]
@@ -463,24 +402,6 @@ impl ::dalembert_runtime::Model<0, 6> for BallFloor {
     fn collide(&self, wall: Wall, q: &[f64; 0], v: &[f64; 6]) -> [f64; 6] {
         match wall {
             Wall::Floor => self.floor_collide(q, v),
-        }
-    }
-    #[inline]
-    fn normal(&self, wall: Wall, q: &[f64; 0]) -> [f64; 6] {
-        match wall {
-            Wall::Floor => self.floor_normal(q),
-        }
-    }
-    #[inline]
-    fn normal_velocity(&self, wall: Wall, q: &[f64; 0], v: &[f64; 6]) -> f64 {
-        match wall {
-            Wall::Floor => self.floor_normal_velocity(q, v),
-        }
-    }
-    #[inline]
-    fn surface_hessian(&self, wall: Wall, q: &[f64; 0], v: &[f64; 6]) -> Option<f64> {
-        match wall {
-            Wall::Floor => Some(self.floor_surface_hessian(q, v)),
         }
     }
 }

@@ -9,15 +9,9 @@
 // Operation counts (f32):
 //   mass_matrix                  0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   kinetic_energy               5 add, 9 mul, 0 div, 0 fn (14 in all)
-//   potential                    0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   constraints                  0 add, 0 mul, 0 div, 0 fn (0 in all)
-//   holonomic                    0 add, 0 mul, 0 div, 0 fn (0 in all)
-//   forcing                      0 add, 0 mul, 0 div, 0 fn (0 in all)
-//   constraint_drift             0 add, 0 mul, 0 div, 0 fn (0 in all)
-//   floor_surface                0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_normal                 0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_normal_velocity        0 add, 0 mul, 0 div, 0 fn (0 in all)
-//   floor_surface_hessian        0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_b_rows                 0 add, 1 mul, 0 div, 0 fn (1 in all)
 //   floor_projector              1 add, 10 mul, 1 div, 0 fn (12 in all)
 //   floor_collide                8 add, 19 mul, 1 div, 0 fn (28 in all)
@@ -150,13 +144,6 @@ impl BallFloor {
         let o0: f32 = 0.5f32 * t3;
         o0
     }
-    /// Potential energy V(q).
-    #[inline]
-    #[allow(unused_variables)]
-    pub fn potential(&self, q: &[f32; 0]) -> f32 {
-        let o0: f32 = 0f32;
-        o0
-    }
     /// Rows of A(q).
     #[inline]
     #[allow(unused_variables)]
@@ -172,37 +159,6 @@ impl BallFloor {
             ],
             0,
         )
-    }
-    /// The holonomic constraints h(q) (zero on the constraint manifold); their differentials are the first rows of A.
-    #[inline]
-    #[allow(unused_variables)]
-    pub fn holonomic(&self, q: &[f32; 0]) -> ([f32; 6], usize) {
-        ([0.0, 0.0, 0.0, 0.0, 0.0, 0.0], 0)
-    }
-    /// h(q, q̇): the equations of motion are G(q) q̈ + h(q, q̇) = A(q)ᵀλ (zero for an instantaneous model).
-    #[inline]
-    #[allow(unused_variables)]
-    pub fn forcing(&self, q: &[f32; 0], v: &[f32; 6]) -> [f32; 6] {
-        let o0: f32 = 0f32;
-        let o1: f32 = 0f32;
-        let o2: f32 = 0f32;
-        let o3: f32 = 0f32;
-        let o4: f32 = 0f32;
-        let o5: f32 = 0f32;
-        [o0, o1, o2, o3, o4, o5]
-    }
-    /// Ȧq̇, one entry per row of A (the rest zero): A q̈ + Ȧq̇ = 0 along the motion.
-    #[inline]
-    #[allow(unused_variables)]
-    pub fn constraint_drift(&self, q: &[f32; 0], v: &[f32; 6]) -> [f32; 6] {
-        [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
-    }
-    /// Wall `floor`: the surface function f(q).
-    #[inline]
-    #[allow(unused_variables)]
-    pub fn floor_surface(&self, q: &[f32; 0]) -> f32 {
-        let o0: f32 = 0f32;
-        o0
     }
     /// Wall `floor`: its normal df(q), the first row of B.
     #[inline]
@@ -222,13 +178,6 @@ impl BallFloor {
     pub fn floor_normal_velocity(&self, q: &[f32; 0], v: &[f32; 6]) -> f32 {
         let i5: f32 = v[2];
         let o0: f32 = i5;
-        o0
-    }
-    /// Wall `floor`: vᵀ∇²f(q)v; along a motion f̈ = df(q)·q̈ + vᵀ∇²f(q)v.
-    #[inline]
-    #[allow(unused_variables)]
-    pub fn floor_surface_hessian(&self, q: &[f32; 0], v: &[f32; 6]) -> f32 {
-        let o0: f32 = 0f32;
         o0
     }
     /// Wall `floor`: the independent rows of B(q), the normal velocity first.

@@ -217,7 +217,7 @@ impl BallWallEuler {
     pub fn holonomic(&self, q: &[f32; 5]) -> ([f32; 5], usize) {
         ([0.0, 0.0, 0.0, 0.0, 0.0], 0)
     }
-    /// h(q, q̇): the equations of motion are G(q) q̈ + h(q, q̇) = A(q)ᵀλ (zero for an instantaneous model).
+    /// h(q, q̇): the equations of motion are G(q) q̈ + h(q, q̇) = A(q)ᵀλ.
     #[inline]
     #[allow(unused_variables)]
     pub fn forcing(&self, q: &[f32; 5], v: &[f32; 5]) -> [f32; 5] {

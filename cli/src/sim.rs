@@ -8,9 +8,9 @@ use std::time::Instant;
 use clap::{Args, ValueEnum};
 use dalembert::for_each_model;
 use dalembert::models::*;
-use dalembert::runtime::Model;
+use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
-    Integrator, Settings, Simulator, State, Step, admissible, residual,
+    DormandPrince, Integrator, Rk4, Settings, Simulator, State, Step, admissible, residual,
 };
 use indicatif::{ProgressBar, ProgressStyle};
 use plotters::prelude::*;
@@ -113,7 +113,7 @@ struct Row<const N: usize> {
     event: Option<&'static str>,
 }
 
-fn run<M: Model<N, N>, const N: usize>(args: &SimulateArgs) -> Result<bool, String> {
+fn run<M: Surfaces<N>, const N: usize>(args: &SimulateArgs) -> Result<bool, String> {
     let mut model = M::with_params(Default::default());
     let mut q = M::INITIAL_COORDINATES;
     let mut v = M::INITIAL_VELOCITIES;
@@ -149,12 +149,12 @@ fn run<M: Model<N, N>, const N: usize>(args: &SimulateArgs) -> Result<bool, Stri
     }
     let v = projected;
     let integrator = match args.integrator {
-        Method::Rk4 => Integrator::Rk4 { step: args.step },
-        Method::DormandPrince => Integrator::DormandPrince {
+        Method::Rk4 => Integrator::Rk4(Rk4 { step: args.step }),
+        Method::DormandPrince => Integrator::DormandPrince(DormandPrince {
             rtol: args.rtol,
             atol: args.atol,
             max_step: f64::INFINITY,
-        },
+        }),
     };
     let settings = Settings {
         integrator,
@@ -256,7 +256,7 @@ fn run<M: Model<N, N>, const N: usize>(args: &SimulateArgs) -> Result<bool, Stri
     }
 }
 
-fn record<M: Model<N, N>, const N: usize>(rows: &mut Vec<Row<N>>, step: &Step<M::Wall, N>) {
+fn record<M: Surfaces<N>, const N: usize>(rows: &mut Vec<Row<N>>, step: &Step<M::Wall, N>) {
     if let Some(c) = &step.collision {
         // The state just before the collision, from its record.
         let last = rows.last().map_or(step.energy, |r| r.energy);
@@ -280,7 +280,7 @@ fn record<M: Model<N, N>, const N: usize>(rows: &mut Vec<Row<N>>, step: &Step<M:
     });
 }
 
-fn write_csv<M: Model<N, N>, const N: usize>(file: &Path, rows: &[Row<N>]) -> Result<(), String> {
+fn write_csv<M: Surfaces<N>, const N: usize>(file: &Path, rows: &[Row<N>]) -> Result<(), String> {
     let mut out = String::from("t");
     for name in M::COORDINATES.iter().chain(M::VELOCITIES) {
         out.push(',');
@@ -305,7 +305,7 @@ fn write_csv<M: Model<N, N>, const N: usize>(file: &Path, rows: &[Row<N>]) -> Re
 }
 
 /// Indices of the two coordinates drawn as the path.
-fn path_axes<M: Model<N, N>, const N: usize>(spec: Option<&str>) -> Result<(usize, usize), String> {
+fn path_axes<M: Surfaces<N>, const N: usize>(spec: Option<&str>) -> Result<(usize, usize), String> {
     let find = |name: &str| {
         M::COORDINATES
             .iter()
@@ -341,7 +341,7 @@ fn range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
 }
 
 /// Three panels: the coordinates over time, the path, and the energy drift.
-fn plot<M: Model<N, N>, const N: usize>(
+fn plot<M: Surfaces<N>, const N: usize>(
     file: &Path,
     rows: &[Row<N>],
     (a, b): (usize, usize),

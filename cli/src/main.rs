@@ -13,12 +13,14 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use dalembert::models::BallFloor;
-use dalembert::runtime::Model;
+use dalembert::runtime::Walls;
+use dalembert_codegen::derive::Projection;
+use dalembert_codegen::derive::inspect as symbolic;
+use dalembert_codegen::quantity::Quantity;
 use dalembert_codegen::reference::{Comparison, Reference};
-use dalembert_codegen::symbolic;
 use dalembert_codegen::{Derivation, ModelErrors};
 
-const MODELS_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/models");
+const MODELS_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../models");
 
 #[derive(Parser)]
 #[command(
@@ -104,7 +106,7 @@ fn derive_timed(file: &Path) -> Result<bool, String> {
     let start = std::time::Instant::now();
     let d = derive(file)?;
     let derived = start.elapsed();
-    let code = dalembert_codegen::emit::file(&d);
+    let code = dalembert_codegen::emit::file(&d, dalembert_codegen::Options::default());
     let total = start.elapsed();
     print_derivation(&d);
     println!(
@@ -188,7 +190,7 @@ fn pendulum_demo() {
     let p = ball.params;
     let (v, u) = (1.5, 2.0);
     let v_minus = [-v, 0.0, -u, 0.0, p.r * p.m * v / p.J, 0.0];
-    let v_plus = ball.collide(<BallFloor as Model<0, 6>>::WALLS[0], &[], &v_minus);
+    let v_plus = ball.collide(<BallFloor as Walls<0, 6>>::WALLS[0], &[], &v_minus);
     println!(
         "==================== §3.2.1: nonholonomic pendulum (generated code) ===================="
     );
@@ -246,13 +248,17 @@ fn print_latex(d: &Derivation) -> Result<bool, String> {
     for w in &d.walls {
         println!("% wall `{}`", w.name);
         println!("B = {}", latex_matrix(&w.b_rows)?);
-        if w.structured {
+        let Projection::ClosedForm {
+            projector,
+            collision,
+        } = &w.projection
+        else {
             println!("% P: structured evaluation (solved at run time from G and B)");
             continue;
-        }
-        println!("P = {}", latex_matrix(&w.projector)?);
+        };
+        println!("P = {}", latex_matrix(projector)?);
         println!("\\begin{{aligned}}");
-        for (name, c) in m.velocities.iter().zip(&w.collision) {
+        for (name, c) in m.velocities.iter().zip(collision) {
             println!(
                 "  {}^+ &= {} \\\\",
                 symbolic::latex(name)?,
@@ -300,21 +306,30 @@ fn print_derivation(d: &Derivation) -> bool {
         if !w.dropped.is_empty() {
             println!("  dependent rows removed: {}", w.dropped.join("; "));
         }
-        if w.structured {
+        let Projection::ClosedForm {
+            projector,
+            collision,
+        } = &w.projection
+        else {
             println!(
                 "P and the collision map: structured evaluation (solved at run time from G and B; set `projector = \"symbolic\"` under [model] for closed forms)"
             );
             continue;
-        }
-        print_matrix("P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B =", &w.projector);
+        };
+        print_matrix("P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B =", projector);
         println!("collision law v⁺ = (I − 2P)v⁻:");
-        for (name, c) in m.velocities.iter().zip(&w.collision) {
+        for (name, c) in m.velocities.iter().zip(collision) {
             println!("  {name}⁺ = {c}");
         }
+        let count = |q| {
+            w.function(q)
+                .map(|f| f.program.op_count().to_string())
+                .unwrap_or_default()
+        };
         println!(
             "operation counts: projector {}; collision map {}",
-            w.programs.projector.op_count(),
-            w.programs.collide.op_count()
+            count(Quantity::Projector),
+            count(Quantity::Collide)
         );
     }
     true

@@ -1,0 +1,294 @@
+//! The model's checks, one function each. Every failed check records an
+//! error at the offending text and the derivation goes on where it can, so
+//! that one run reports everything it finds.
+//!
+//! | check | where it runs |
+//! |---|---|
+//! | [`kinetic_energy_quadratic`]: T = ½ vᵀG v | pass 2, on T |
+//! | [`linear_row`]: a velocity-level constraint is linear and homogeneous in v | pass 2, on each constraint and contact row |
+//! | [`no_velocity`]: V, h and f do not depend on v | pass 2 |
+//! | [`positive_definite`]: G > 0 at the sample point | after the mass matrix's program |
+//! | [`wall_hypotheses`]: (1.3) ker B ⊆ ker A and ker A ⊄ TN, exactly | per wall, for generic q |
+//! | [`on_wall`]: B of full rank and (1.3) at a point of N itself | per wall with a surface |
+
+use std::ops::Range;
+
+use symbolica::prelude::*;
+
+use super::evaluate::program;
+use super::symbols::Symbols;
+use super::{Field, Rat, is_zero, rows_matrix};
+use crate::diag::{Collector, ErrorKind, Reported};
+use crate::ir::Wall;
+use crate::program::Program;
+
+/// T must equal ½ vᵀ G v: G's entries free of velocities, nothing of degree
+/// 0 or 1 left over.
+pub fn kinetic_energy_quadratic(sym: &Symbols, cx: &mut Collector, t: &Atom, g: &[Vec<Atom>]) {
+    let span = sym.model.kinetic_energy.span.clone();
+    for e in g.iter().flatten() {
+        for (k, v) in sym.vels.iter().enumerate() {
+            if !is_zero(&e.derivative(*v)) {
+                cx.error(
+                    ErrorKind::NotQuadratic(format!(
+                        "its second derivatives still depend on `{}` (terms of degree > 2)",
+                        sym.model.velocities[k]
+                    )),
+                    Some(span),
+                );
+                return;
+            }
+        }
+    }
+    let mut quad = Atom::num(0);
+    for (i, vi) in sym.vels.iter().enumerate() {
+        for (j, vj) in sym.vels.iter().enumerate() {
+            quad += g[i][j].clone() * Atom::from(*vi) * Atom::from(*vj);
+        }
+    }
+    let rest = (t.clone() - quad / Atom::num(2)).expand();
+    if !is_zero(&rest) {
+        cx.error(
+            ErrorKind::NotQuadratic(format!(
+                "T − ½vᵀGv = {rest} (terms of degree 0 or 1 in the velocities)"
+            )),
+            Some(span),
+        );
+    }
+}
+
+/// The coefficient row of a velocity-level expression, which must be
+/// linear and homogeneous in the velocities.
+pub fn linear_row(
+    sym: &Symbols,
+    cx: &mut Collector,
+    e: &Atom,
+    span: &Range<usize>,
+) -> Result<Vec<Atom>, Reported> {
+    let row: Vec<Atom> = sym.vels.iter().map(|v| e.derivative(*v).expand()).collect();
+    for c in &row {
+        for (k, v) in sym.vels.iter().enumerate() {
+            if !is_zero(&c.derivative(*v)) {
+                return Err(cx.error(
+                    ErrorKind::NotLinear(format!(
+                        "its coefficients depend on the velocity `{}`",
+                        sym.model.velocities[k]
+                    )),
+                    Some(span.clone()),
+                ));
+            }
+        }
+    }
+    let mut lin = Atom::num(0);
+    for (c, v) in row.iter().zip(&sym.vels) {
+        lin += c.clone() * Atom::from(*v);
+    }
+    let rest = (e.clone() - lin).expand();
+    if !is_zero(&rest) {
+        return Err(cx.error(
+            ErrorKind::NotLinear(format!("it has a part free of the velocities: {rest}")),
+            Some(span.clone()),
+        ));
+    }
+    if row.iter().all(is_zero) {
+        return Err(cx.error(
+            ErrorKind::NotLinear("it does not involve any velocity".into()),
+            Some(span.clone()),
+        ));
+    }
+    Ok(row)
+}
+
+/// `e` must not depend on any velocity (`kind` names the first it does).
+pub fn no_velocity(
+    sym: &Symbols,
+    cx: &mut Collector,
+    e: &Atom,
+    span: &Range<usize>,
+    kind: impl Fn(String) -> ErrorKind,
+) {
+    for (k, v) in sym.vels.iter().enumerate() {
+        if !is_zero(&e.derivative(*v)) {
+            cx.error(kind(sym.model.velocities[k].clone()), Some(span.clone()));
+            return;
+        }
+    }
+}
+
+/// G positive definite at the sample point (file's parameter values,
+/// [`super::symbols::sample_configuration`]): symmetric, finite, and a
+/// Cholesky factorisation succeeds.
+pub fn positive_definite(sym: &Symbols, cx: &mut Collector, mass_matrix: &Program) {
+    let n = sym.vels.len();
+    let vals = mass_matrix.eval(&sym.sample_inputs());
+    let gm = nalgebra::DMatrix::from_row_slice(n, n, &vals);
+    let symmetric = (0..n).all(|i| {
+        (0..n).all(|j| (gm[(i, j)] - gm[(j, i)]).abs() <= 1e-12 * (1.0 + gm[(i, j)].abs()))
+    });
+    if !symmetric || gm.clone().cholesky().is_none() || vals.iter().any(|x| !x.is_finite()) {
+        cx.error(
+            ErrorKind::NotPositiveDefinite {
+                at: sym.sample_description(),
+            },
+            Some(sym.model.kinetic_energy.span.clone()),
+        );
+    }
+}
+
+/// (1.3): ker B ⊆ ker A (A's rows lie in B's row space) and ker A ⊄ TN
+/// (the normal row is not in A's row space), checked exactly for generic
+/// parameters and configurations.
+pub fn wall_hypotheses(
+    cx: &mut Collector,
+    w: &Wall,
+    b: &[Vec<Rat>],
+    a: &[Vec<Rat>],
+    normal: &[Rat],
+    field: &Field,
+) {
+    let n = normal.len();
+    let at = "generic parameters and configurations".to_string();
+    let rank = |rows: &[Vec<Rat>]| -> usize {
+        if rows.is_empty() {
+            return 0;
+        }
+        rows_matrix(rows, n, field).map(|m| m.rank()).unwrap_or(0)
+    };
+    let rb = rank(b);
+    let mut ba = b.to_vec();
+    ba.extend(a.iter().cloned());
+    if rank(&ba) > rb {
+        cx.error(
+            ErrorKind::Hypothesis {
+                wall: w.name.clone(),
+                condition:
+                    "ker B ⊆ ker A (1.3): some constraint row is not implied by the wall's rows"
+                        .into(),
+                at: at.clone(),
+            },
+            Some(w.span.clone()),
+        );
+    }
+    let ra = rank(a);
+    let mut an = a.to_vec();
+    an.push(normal.to_vec());
+    if rank(&an) == ra {
+        cx.error(
+            ErrorKind::Hypothesis {
+                wall: w.name.clone(),
+                condition: "ker A ⊄ TₓN (1.3): the constraints already forbid motion across the wall, or its normal velocity is zero".into(),
+                at,
+            },
+            Some(w.span.clone()),
+        );
+    }
+}
+
+/// What [`on_wall`] evaluates: f, df and the rows of A and B.
+pub struct WallRows<'r> {
+    /// f.
+    pub surface: &'r Atom,
+    /// df.
+    pub normal: &'r [Atom],
+    /// Rows of A.
+    pub a: &'r [Vec<Atom>],
+    /// Independent rows of B.
+    pub b: &'r [Vec<Atom>],
+}
+
+/// (1.3) and B's rank at a point of the wall itself: the sample
+/// configuration moved onto N = {f = 0} by Newton steps along ∇f, at the
+/// file's parameter values. Catches models that satisfy the hypotheses for
+/// generic q but break them on N.
+pub fn on_wall(sym: &Symbols, cx: &mut Collector, w: &Wall, rows: &WallRows) {
+    let n = sym.vels.len();
+    let mut outputs = vec![rows.surface.clone()];
+    outputs.extend(rows.normal.iter().cloned());
+    outputs.extend(rows.a.iter().flatten().cloned());
+    outputs.extend(rows.b.iter().flatten().cloned());
+    let prog = match program(&outputs, &sym.inputs()) {
+        Ok(p) => p,
+        Err(e) => {
+            cx.error(ErrorKind::Symbolic(e), Some(w.span.clone()));
+            return;
+        }
+    };
+    let np = sym.params.len();
+    let Some(x) = point_on_wall(&prog, sym.sample_inputs(), np, n) else {
+        // No point of N found near the sample: the generic checks stand.
+        return;
+    };
+    let out = prog.eval(&x);
+    let matrix = |from: usize, count: usize| -> nalgebra::DMatrix<f64> {
+        nalgebra::DMatrix::from_fn(count, n, |i, j| out[from + i * n + j])
+    };
+    let normal_m = matrix(1, 1);
+    let a_m = matrix(1 + n, rows.a.len());
+    let b_m = matrix(1 + n + rows.a.len() * n, rows.b.len());
+    let at = format!(
+        "the point {} of the wall",
+        sym.point_description(&x[np..np + n])
+    );
+    let rb = numeric_rank(&b_m);
+    let mut failures = Vec::new();
+    if rb < rows.b.len() {
+        failures.push("B of full row rank");
+    }
+    if numeric_rank(&stack(&b_m, &a_m)) > rb {
+        failures.push("ker B ⊆ ker A (1.3)");
+    }
+    if numeric_rank(&stack(&a_m, &normal_m)) == numeric_rank(&a_m) {
+        failures.push("ker A ⊄ TₓN (1.3): the constraints forbid motion across the wall there");
+    }
+    for condition in failures {
+        cx.error(
+            ErrorKind::Hypothesis {
+                wall: w.name.clone(),
+                condition: condition.into(),
+                at: at.clone(),
+            },
+            Some(w.span.clone()),
+        );
+    }
+}
+
+/// The inputs `x` moved onto f = 0 (the program's first output, its
+/// gradient the next `n`) by Newton steps in the coordinates, which follow
+/// the `np` parameters.
+fn point_on_wall(prog: &Program, mut x: Vec<f64>, np: usize, n: usize) -> Option<Vec<f64>> {
+    for _ in 0..100 {
+        let out = prog.eval(&x);
+        let f = out[0];
+        let grad = &out[1..1 + n];
+        let g2: f64 = grad.iter().map(|g| g * g).sum();
+        let scale = 1.0 + x[np..np + n].iter().fold(0.0_f64, |m, q| m.max(q.abs()));
+        if f.abs() <= 1e-12 * scale {
+            return Some(x);
+        }
+        if g2.is_nan() || g2 <= 0.0 || !f.is_finite() {
+            return None;
+        }
+        for k in 0..n {
+            x[np + k] -= f * grad[k] / g2;
+        }
+    }
+    None
+}
+
+/// The rows of `p` above those of `q`.
+fn stack(p: &nalgebra::DMatrix<f64>, q: &nalgebra::DMatrix<f64>) -> nalgebra::DMatrix<f64> {
+    let mut m = nalgebra::DMatrix::zeros(p.nrows() + q.nrows(), p.ncols());
+    m.rows_mut(0, p.nrows()).copy_from(p);
+    m.rows_mut(p.nrows(), q.nrows()).copy_from(q);
+    m
+}
+
+/// Rank by singular values, relative to the largest.
+fn numeric_rank(m: &nalgebra::DMatrix<f64>) -> usize {
+    if m.nrows() == 0 {
+        return 0;
+    }
+    let sv = m.clone().svd(false, false).singular_values;
+    let max = sv.iter().fold(0.0_f64, |a, b| a.max(*b));
+    sv.iter().filter(|s| **s > 1e-9 * max.max(1e-300)).count()
+}

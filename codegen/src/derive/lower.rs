@@ -1,0 +1,192 @@
+//! Pass 3: function applications lowered to symbols, so that every entry of
+//! G, A and B is a rational function of symbols and exact linear algebra
+//! applies; sin² + cos² = 1 reduced; the functions raised back before
+//! evaluation.
+//!
+//! A [`Lowering`] is made only from the whole [`Raw`] derivation, so no
+//! expression that is later turned into a rational function can miss it.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use symbolica::prelude::*;
+
+use super::mechanics::Raw;
+use super::symbols::Symbols;
+use super::{Rat, is_zero};
+use crate::ir::FUNCTIONS;
+
+/// A function application replaced by a symbol while matrices are computed.
+struct Lowered {
+    symbol: Symbol,
+    function: Atom,
+}
+
+/// The lowered function applications of one model and the variables of its
+/// rational functions.
+pub struct Lowering {
+    lowered: Vec<Lowered>,
+    /// (sin symbol, cos symbol) of the same argument.
+    trig_pairs: Vec<(Symbol, Symbol)>,
+    vars: Arc<Vec<PolyVariable>>,
+}
+
+impl Lowering {
+    /// Finds every application of a model function in `raw` and gives it a
+    /// symbol; sin and cos of the same argument are paired for the
+    /// reduction.
+    pub fn new(sym: &Symbols, raw: &Raw) -> Self {
+        let mut lowered: Vec<Lowered> = Vec::new();
+        let mut seen: HashMap<String, usize> = HashMap::new();
+        let mut args_by_fn: HashMap<String, (Option<Symbol>, Option<Symbol>)> = HashMap::new();
+        let atoms = raw.expressions();
+        for f in FUNCTIONS {
+            let Ok(pat) = try_parse!(format!("{f}(x__dalembert_arg_)").as_str()) else {
+                continue;
+            };
+            let pattern = pat.to_pattern();
+            for a in &atoms {
+                let mut it = a.pattern_match(&pattern, None, None);
+                while let Some(found) = it.next_detailed() {
+                    for (_, v) in found.match_stack {
+                        let Match::Single(arg) = v else { continue };
+                        let arg = arg.to_owned();
+                        let Ok(app) = try_parse!(format!("{f}({arg})").as_str()) else {
+                            continue;
+                        };
+                        let key = app.to_string();
+                        if seen.contains_key(&key) {
+                            continue;
+                        }
+                        let s = symbol!(format!("fn__{}", lowered.len()).as_str());
+                        seen.insert(key, lowered.len());
+                        lowered.push(Lowered {
+                            symbol: s,
+                            function: app,
+                        });
+                        let pair = args_by_fn.entry(arg.to_string()).or_default();
+                        match *f {
+                            "sin" => pair.0 = Some(s),
+                            "cos" => pair.1 = Some(s),
+                            _ => {}
+                        }
+                    }
+                }
+            }
+        }
+        let mut trig_pairs: Vec<(Symbol, Symbol)> = args_by_fn
+            .into_values()
+            .filter_map(|(s, c)| Some((s?, c?)))
+            .collect();
+        trig_pairs.sort_by_key(|(s, _)| s.to_string());
+        let mut vars: Vec<PolyVariable> = Vec::new();
+        for s in sym.params.iter().chain(&sym.coords).chain(&sym.vels) {
+            vars.push(PolyVariable::Symbol(*s));
+        }
+        for l in &lowered {
+            vars.push(PolyVariable::Symbol(l.symbol));
+        }
+        Self {
+            lowered,
+            trig_pairs,
+            vars: Arc::new(vars),
+        }
+    }
+
+    fn lower(&self, a: &Atom) -> Atom {
+        let mut a = a.clone();
+        for l in &self.lowered {
+            a = a.replace(l.function.clone()).with(Atom::from(l.symbol));
+        }
+        a
+    }
+
+    /// Lowered symbols back to the functions they stand for.
+    pub fn raise(&self, a: &Atom) -> Atom {
+        let mut a = a.clone();
+        for l in &self.lowered {
+            a = a.replace(Atom::from(l.symbol)).with(l.function.clone());
+        }
+        a
+    }
+
+    fn rat(&self, a: &Atom) -> Rat {
+        a.to_rational_polynomial(&Q, &Z, Some(self.vars.clone()))
+    }
+
+    /// `a` as a rational function of the model's symbols and the lowered
+    /// function applications.
+    pub fn to_rat(&self, a: &Atom) -> Rat {
+        self.rat(&self.lower(a))
+    }
+
+    /// Reduces a polynomial modulo c² + s² − 1 for every sin/cos pair:
+    /// cⁿ → cⁿ⁻²(1 − s²) until no power of c above 1 is left.
+    fn reduce_trig(&self, a: &Atom) -> Atom {
+        let mut a = a.expand();
+        for (s, c) in &self.trig_pairs {
+            let n = symbol!("n__dalembert_pow_");
+            let cond = n.restrict(WildcardRestriction::filter(|m: &Match| match m {
+                Match::Single(x) => x.to_owned() > Atom::num(1),
+                _ => false,
+            }));
+            let Ok(lhs) = try_parse!(format!("{c}^n__dalembert_pow_").as_str()) else {
+                continue;
+            };
+            let Ok(rhs) = try_parse!(format!("{c}^(n__dalembert_pow_-2)*(1-{s}^2)").as_str())
+            else {
+                continue;
+            };
+            for _ in 0..64 {
+                let next = a
+                    .replace(lhs.clone())
+                    .when(&cond)
+                    .with(rhs.clone())
+                    .expand();
+                if next == a {
+                    break;
+                }
+                a = next;
+            }
+        }
+        a
+    }
+
+    /// A rational function in lowest terms, sin² + cos² = 1 reduced,
+    /// functions raised.
+    pub fn simplify(&self, r: &Rat) -> Atom {
+        let num = self.reduce_trig(&r.numerator.to_expression());
+        let den = self.reduce_trig(&r.denominator.to_expression());
+        let reduced = self.rat(&(num / den));
+        self.raise(&reduced.to_expression())
+    }
+
+    /// [`Lowering::simplify`] of an expression.
+    pub fn reduce(&self, a: &Atom) -> Atom {
+        self.simplify(&self.to_rat(a))
+    }
+
+    /// v⁺ component printed as a combination of the velocities.
+    pub fn collect_velocities(&self, sym: &Symbols, c: &Atom) -> String {
+        let mut terms = Vec::new();
+        for (k, v) in sym.vels.iter().enumerate() {
+            let coeff = self.reduce(&c.derivative(*v));
+            if is_zero(&coeff) {
+                continue;
+            }
+            let name = &sym.model.velocities[k];
+            if is_zero(&(coeff.clone() - Atom::num(1))) {
+                terms.push(name.clone());
+            } else if is_zero(&(coeff.clone() + Atom::num(1))) {
+                terms.push(format!("-{name}"));
+            } else {
+                terms.push(format!("({coeff})*{name}"));
+            }
+        }
+        if terms.is_empty() {
+            "0".into()
+        } else {
+            terms.join(" + ")
+        }
+    }
+}

@@ -1,0 +1,401 @@
+//! Pass 2: the mechanics in exact expressions. T and V parsed; G = ∂²T/∂v²;
+//! the rows of A (the holonomic constraints' differentials first); the
+//! Lagrange–d'Alembert equations' h and Ȧq̇; each wall's f, normal df,
+//! vᵀ∇²f v and contact rows. Then, after lowering (pass 3), G exactly, the
+//! symbolic-or-structured choice, and q̈ in closed form where G⁻¹ is exact.
+
+use symbolica::prelude::*;
+
+use super::checks;
+use super::lower::Lowering;
+use super::symbols::Symbols;
+use super::{Field, Rat, is_zero, rows_matrix};
+use crate::diag::{Collector, ErrorKind, Reported};
+use crate::ir::{Kind, ProjectorMode, Wall};
+
+/// The model's mechanics as expressions, before any exact linear algebra.
+pub struct Raw {
+    /// T.
+    pub t: Atom,
+    /// V.
+    pub v: Atom,
+    /// G, entry by entry.
+    pub g: Vec<Vec<Atom>>,
+    /// Rows of A: dh for every holonomic constraint, then the velocity-level
+    /// constraints.
+    pub a_rows: Vec<Vec<Atom>>,
+    /// Where each row of A comes from.
+    pub a_labels: Vec<String>,
+    /// h(q).
+    pub holonomic: Vec<Atom>,
+    /// h(q, q̇) of G q̈ + h = Aᵀλ.
+    pub forcing: Vec<Atom>,
+    /// Ȧq̇, one per row of A.
+    pub drift: Vec<Atom>,
+    /// Per wall.
+    pub walls: Vec<RawWall>,
+}
+
+/// One wall's geometry and contact rows as expressions.
+pub struct RawWall {
+    /// f (0 for an instantaneous model).
+    pub surface: Atom,
+    /// df, or the normal-velocity row of an instantaneous model.
+    pub normal: Vec<Atom>,
+    /// vᵀ∇²f(q)v (0 for an instantaneous model).
+    pub hessian: Atom,
+    /// The contact rows.
+    pub contact: Vec<Vec<Atom>>,
+}
+
+impl Raw {
+    /// Every expression that later becomes a rational function, so that the
+    /// lowering sees all of them. The destructuring is exhaustive: a new
+    /// field must be listed here or named as not needed.
+    pub fn expressions(&self) -> Vec<&Atom> {
+        let Raw {
+            t,
+            v,
+            g,
+            a_rows,
+            a_labels: _,
+            // Evaluated as they are, never as rational functions.
+            holonomic: _,
+            forcing,
+            drift,
+            walls,
+        } = self;
+        let mut out: Vec<&Atom> = g.iter().flatten().collect();
+        out.extend(a_rows.iter().flatten());
+        out.extend(forcing);
+        out.extend(drift);
+        out.extend([t, v]);
+        for w in walls {
+            let RawWall {
+                surface: _,
+                normal,
+                hessian,
+                contact,
+            } = w;
+            out.extend(normal);
+            out.push(hessian);
+            out.extend(contact.iter().flatten());
+        }
+        out
+    }
+}
+
+/// Pass 2: parses T, V, the constraints and the walls, and derives G, A,
+/// the equations of motion and each wall's geometry, checking each as it
+/// goes (T quadratic, constraints linear, no velocity where none belongs).
+#[allow(clippy::needless_range_loop)] // matrix code reads best with indices
+pub fn raw(sym: &Symbols, cx: &mut Collector) -> Result<Raw, Reported> {
+    let m = sym.model;
+    let n = m.velocities.len();
+    let t = sym.parse(&m.kinetic_energy, cx)?;
+    let v = match &m.potential {
+        Some(p) => {
+            let v = sym.parse(p, cx)?;
+            checks::no_velocity(sym, cx, &v, &p.span, ErrorKind::VelocityInPotential);
+            v
+        }
+        None => Atom::num(0),
+    };
+    let mut g = vec![vec![Atom::num(0); n]; n];
+    for i in 0..n {
+        let ti = t.derivative(sym.vels[i]);
+        for j in 0..n {
+            g[i][j] = ti.derivative(sym.vels[j]).expand();
+        }
+    }
+    checks::kinetic_energy_quadratic(sym, cx, &t, &g);
+
+    let mut a_rows = Vec::new();
+    let mut a_labels = Vec::new();
+    let mut holonomic = Vec::new();
+    for (k, c) in m.holonomic.iter().enumerate() {
+        let h = sym.parse(c, cx)?;
+        checks::no_velocity(sym, cx, &h, &c.span, ErrorKind::VelocityInHolonomic);
+        a_rows.push(
+            sym.coords
+                .iter()
+                .map(|q| h.derivative(*q).expand())
+                .collect::<Vec<_>>(),
+        );
+        a_labels.push(format!("holonomic constraint {}", k + 1));
+        holonomic.push(h);
+    }
+    for (k, c) in m.constraints.iter().enumerate() {
+        a_labels.push(format!("constraint {}", k + 1));
+        let e = sym.parse(c, cx)?;
+        a_rows.push(checks::linear_row(sym, cx, &e, &c.span)?);
+    }
+    let (forcing, drift) = equations_of_motion(sym, &t, &v, &a_rows);
+    let walls = m
+        .walls
+        .iter()
+        .map(|w| raw_wall(sym, cx, w))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(Raw {
+        t,
+        v,
+        g,
+        a_rows,
+        a_labels,
+        holonomic,
+        forcing,
+        drift,
+        walls,
+    })
+}
+
+/// A wall's f, df (or its normal-velocity row), vᵀ∇²f v and contact rows.
+fn raw_wall(sym: &Symbols, cx: &mut Collector, w: &Wall) -> Result<RawWall, Reported> {
+    let n = sym.vels.len();
+    let missing = |cx: &mut Collector, what: &str| {
+        cx.error(
+            ErrorKind::Structure(format!("wall `{}` has no `{what}`", w.name)),
+            Some(w.span.clone()),
+        )
+    };
+    let (surface, normal, hessian) = match sym.model.kind {
+        Kind::Coordinates => {
+            let e = w.surface.as_ref().ok_or_else(|| missing(cx, "surface"))?;
+            let f = sym.parse(e, cx)?;
+            checks::no_velocity(sym, cx, &f, &e.span, |v| ErrorKind::VelocityInSurface {
+                wall: w.name.clone(),
+                velocity: v,
+            });
+            let mut row = vec![Atom::num(0); n];
+            for (k, q) in sym.coords.iter().enumerate() {
+                row[k] = f.derivative(*q).expand();
+            }
+            let hessian = hessian_form(sym, &row);
+            (f, row, hessian)
+        }
+        Kind::Instantaneous => {
+            let e = w
+                .normal_velocity
+                .as_ref()
+                .ok_or_else(|| missing(cx, "normal_velocity"))?;
+            let atom = sym.parse(e, cx)?;
+            let row = checks::linear_row(sym, cx, &atom, &e.span)?;
+            (Atom::num(0), row, Atom::num(0))
+        }
+    };
+    let mut contact = Vec::new();
+    for c in &w.contact {
+        let e = sym.parse(c, cx)?;
+        contact.push(checks::linear_row(sym, cx, &e, &c.span)?);
+    }
+    Ok(RawWall {
+        surface,
+        normal,
+        hessian,
+        contact,
+    })
+}
+
+/// The Lagrange–d'Alembert equations G q̈ + h = Aᵀλ with A q̇ = 0:
+/// hᵢ = Σₖ ∂²T/∂q̇ᵢ∂qₖ q̇ₖ − ∂T/∂qᵢ + ∂V/∂qᵢ, and differentiating A q̇ = 0
+/// in time gives A q̈ + Ȧq̇ = 0 with (Ȧq̇)ᵣ = Σⱼ ∂(Aᵣq̇)/∂qⱼ q̇ⱼ.
+/// An instantaneous model has no motion between collisions: both are zero.
+fn equations_of_motion(
+    sym: &Symbols,
+    t: &Atom,
+    v: &Atom,
+    a_rows: &[Vec<Atom>],
+) -> (Vec<Atom>, Vec<Atom>) {
+    let n = sym.vels.len();
+    if sym.model.kind == Kind::Instantaneous {
+        return (vec![Atom::num(0); n], vec![Atom::num(0); a_rows.len()]);
+    }
+    let forcing = (0..n)
+        .map(|i| {
+            let q = sym.coords[i];
+            let ti = t.derivative(sym.vels[i]);
+            let mut h = v.derivative(q) - t.derivative(q);
+            for (k, qk) in sym.coords.iter().enumerate() {
+                h += ti.derivative(*qk) * sym.vel(k);
+            }
+            h
+        })
+        .collect();
+    let drift = a_rows
+        .iter()
+        .map(|row| {
+            let mut e = Atom::num(0);
+            for (k, a) in row.iter().enumerate() {
+                e += a.clone() * sym.vel(k);
+            }
+            let mut c = Atom::num(0);
+            for (j, qj) in sym.coords.iter().enumerate() {
+                c += e.derivative(*qj) * sym.vel(j);
+            }
+            c
+        })
+        .collect();
+    (forcing, drift)
+}
+
+/// vᵀ∇²f(q)v from the normal df = `row`: Σₖ (Σᵢ ∂ₖ∂ᵢf vᵢ) vₖ.
+fn hessian_form(sym: &Symbols, row: &[Atom]) -> Atom {
+    let mut form = Atom::num(0);
+    for (k, entry) in row.iter().enumerate() {
+        let mut rate = Atom::num(0);
+        for (i, q) in sym.coords.iter().enumerate() {
+            rate += entry.derivative(*q) * sym.vel(i);
+        }
+        form += rate * sym.vel(k);
+    }
+    form.expand()
+}
+
+/// G and A as exact rational functions, and how P will be evaluated.
+pub struct Exact {
+    /// G with sin² + cos² reduced, entry by entry.
+    pub g: Vec<Vec<Atom>>,
+    /// G as an exact matrix.
+    g_mat: Matrix<Field>,
+    /// The field of G's entries.
+    pub field: Field,
+    /// Rows of A.
+    pub a: Vec<Vec<Rat>>,
+    /// P is solved at run time from G and B rather than derived.
+    pub structured: bool,
+}
+
+/// G and A exactly, and the symbolic-or-structured choice.
+pub fn exact(
+    sym: &Symbols,
+    low: &Lowering,
+    raw: &Raw,
+    cx: &mut Collector,
+) -> Result<Exact, Reported> {
+    let m = sym.model;
+    let n = m.velocities.len();
+    let g_rat: Vec<Rat> = raw.g.iter().flatten().map(|a| low.to_rat(a)).collect();
+    let field = Field::from_poly(&g_rat[0].numerator);
+    let g_mat = Matrix::from_linear(g_rat, n as u32, n as u32, field.clone()).map_err(|e| {
+        cx.error(
+            ErrorKind::Symbolic(format!("the mass matrix: {e:?}")),
+            Some(m.kinetic_energy.span.clone()),
+        )
+    })?;
+    let a = raw
+        .a_rows
+        .iter()
+        .map(|r| r.iter().map(|x| low.to_rat(x)).collect())
+        .collect();
+    let g: Vec<Vec<Atom>> = raw
+        .g
+        .iter()
+        .map(|r| r.iter().map(|x| low.reduce(x)).collect())
+        .collect();
+    let structured = match m.projector {
+        ProjectorMode::Symbolic => false,
+        ProjectorMode::Structured => true,
+        ProjectorMode::Auto => off_diagonal_entries(&g) > 2 * n,
+    };
+    Ok(Exact {
+        g,
+        g_mat,
+        field,
+        a,
+        structured,
+    })
+}
+
+impl Exact {
+    /// G⁻¹ where P will be closed-form; `None` when it is structured (the
+    /// exact G⁻¹ is what makes a symbolic P expensive, and structured
+    /// evaluation never needs it: G > 0 is checked numerically).
+    pub fn inverse(
+        &self,
+        sym: &Symbols,
+        cx: &mut Collector,
+    ) -> Result<Option<Matrix<Field>>, Reported> {
+        if self.structured {
+            return Ok(None);
+        }
+        let inv = self.g_mat.inv().map_err(|_| {
+            cx.error(
+                ErrorKind::NotPositiveDefinite {
+                    at: "every configuration (G is singular)".into(),
+                },
+                Some(sym.model.kinetic_energy.span.clone()),
+            )
+        })?;
+        Ok(Some(inv))
+    }
+}
+
+/// Number of non-zero entries off the diagonal. A symbolic G⁻¹ (and so P)
+/// stays small while G is this sparse; the chain family measures how fast
+/// it grows when G is dense (docs/performance.md).
+fn off_diagonal_entries(g: &[Vec<Atom>]) -> usize {
+    g.iter()
+        .enumerate()
+        .map(|(i, row)| {
+            row.iter()
+                .enumerate()
+                .filter(|(j, a)| i != *j && !is_zero(a))
+                .count()
+        })
+        .sum()
+}
+
+/// q̈ of the equations of motion in closed form, where G⁻¹ is exact and the
+/// rows of A are independent; `None` otherwise (the run time then solves
+/// numerically).
+pub fn accelerations(
+    sym: &Symbols,
+    low: &Lowering,
+    raw: &Raw,
+    exact: &Exact,
+    g_inv: Option<&Matrix<Field>>,
+    cx: &mut Collector,
+) -> Result<Option<Vec<Atom>>, Reported> {
+    let (Some(g_inv), Kind::Coordinates) = (g_inv, sym.model.kind) else {
+        return Ok(None);
+    };
+    let n = sym.vels.len();
+    let span = Some(sym.model.kinetic_energy.span.clone());
+    let mut fail = |what: &str| {
+        cx.error(
+            ErrorKind::Symbolic(format!("the equations of motion: {what}")),
+            span.clone(),
+        )
+    };
+    let column = |e: &[Atom]| {
+        let r: Vec<Rat> = e.iter().map(|a| low.to_rat(&(-a.clone()))).collect();
+        Matrix::from_linear(r, e.len() as u32, 1, exact.field.clone()).ok()
+    };
+    let neg_h = column(&raw.forcing).ok_or_else(|| fail("h as a column"))?;
+    let constrained = if exact.a.is_empty() {
+        None
+    } else {
+        let a = rows_matrix(&exact.a, n, &exact.field).ok_or_else(|| fail("A as a matrix"))?;
+        let c = column(&raw.drift).ok_or_else(|| fail("Ȧq̇ as a column"))?;
+        Some((a, c))
+    };
+    Ok(solve_motion(g_inv, constrained.as_ref(), &neg_h)
+        .map(|x| (0..n).map(|i| low.simplify(&x[(i as u32, 0)])).collect()))
+}
+
+/// q̈ of G q̈ + h = Aᵀλ, A q̈ + Ȧq̇ = 0, from −h and (A, −Ȧq̇): with
+/// z = −G⁻¹h and Y = G⁻¹Aᵀ, (AY)λ = −Ȧq̇ − Az and q̈ = z + Yλ. `None` when
+/// AY is singular (dependent rows of A).
+fn solve_motion(
+    g_inv: &Matrix<Field>,
+    constraints: Option<&(Matrix<Field>, Matrix<Field>)>,
+    neg_h: &Matrix<Field>,
+) -> Option<Matrix<Field>> {
+    let z = g_inv * neg_h;
+    let Some((a, neg_c)) = constraints else {
+        return Some(z);
+    };
+    let y = g_inv * &a.transpose();
+    let lambda = &(a * &y).inv().ok()? * &(neg_c - &(a * &z));
+    Some(&z + &(&y * &lambda))
+}

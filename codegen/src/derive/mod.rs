@@ -1,0 +1,166 @@
+//! Stage 2: exact derivation, as named passes. The only part of the
+//! generator that uses symbolica.
+//!
+//! 1. [`symbols`]: names to symbols, definitions substituted;
+//! 2. [`mechanics`]: G = ∂²T/∂v², the rows of A, the Lagrange–d'Alembert
+//!    equations and each wall's geometry as expressions ([`checks`] run on
+//!    each as it is made);
+//! 3. [`lower`]: function applications to symbols, so that entries are
+//!    rational functions; sin² + cos² = 1 reduced;
+//! 4. [`walls`]: B, the hypotheses (1.3), P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B (Lemma 1,
+//!    eq. 2.4) and (I − 2P)v (eq. 2.13), exactly;
+//! 5. [`evaluate`]: each emitted function to an optimised straight-line
+//!    program (symbolica's evaluator: common subexpressions, Horner).
+//!
+//! The result is plain data ([`Derivation`]); [`inspect`] has symbolic
+//! helpers for front ends and tests.
+
+mod checks;
+mod evaluate;
+pub mod inspect;
+mod lower;
+mod mechanics;
+mod output;
+mod symbols;
+mod walls;
+
+use symbolica::prelude::*;
+
+pub use output::{Derivation, Function, Geometry, Projection, WallDerivation};
+pub use symbols::sample_configuration;
+
+use crate::diag::{Collector, ErrorKind, ModelErrors, Reported};
+use crate::ir::{Kind, Model};
+use crate::quantity::Quantity;
+
+type Rat = RationalPolynomial<IntegerRing, u16>;
+type Field = RationalPolynomialField<IntegerRing, u16>;
+
+/// Derives everything for `model`. A failure always carries at least one
+/// diagnostic.
+pub fn derive(model: &Model) -> Result<Derivation, ModelErrors> {
+    let mut cx = Collector::new(&model.file, &model.source);
+    let result = match crate::lock::acquire() {
+        Ok(()) => run(model, &mut cx),
+        Err(e) => Err(cx.error(ErrorKind::Symbolic(e), None)),
+    };
+    cx.conclude(result)
+}
+
+/// The passes in order.
+fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
+    let sym = symbols::Symbols::new(model, cx)?;
+    let raw = mechanics::raw(&sym, cx)?;
+    let low = lower::Lowering::new(&sym, &raw);
+    let exact = mechanics::exact(&sym, &low, &raw, cx)?;
+    let compile = Compiler {
+        inputs: sym.inputs(),
+        kind: model.kind,
+        span: Some(model.kinetic_energy.span.clone()),
+    };
+    let g_flat: Vec<Atom> = exact.g.iter().flatten().cloned().collect();
+    let mass_matrix = compile.program(cx, Quantity::MassMatrix, &g_flat, 0)?;
+    checks::positive_definite(&sym, cx, &mass_matrix.program);
+    let g_inv = exact.inverse(&sym, cx)?;
+    let context = walls::Context {
+        sym: &sym,
+        low: &low,
+        raw: &raw,
+        exact: &exact,
+        g_inv: g_inv.as_ref(),
+        compile: &compile,
+    };
+    let walls = walls::derive(&context, cx)?;
+    let accelerations = mechanics::accelerations(&sym, &low, &raw, &exact, g_inv.as_ref(), cx)?;
+    let a_flat: Vec<Atom> = raw.a_rows.iter().flatten().cloned().collect();
+    let mut functions = vec![Some(mass_matrix)];
+    for (quantity, outputs, rows) in [
+        (Quantity::KineticEnergy, vec![low.reduce(&raw.t)], 0),
+        (Quantity::Potential, vec![low.reduce(&raw.v)], 0),
+        (Quantity::Constraints, a_flat, raw.a_rows.len()),
+        (
+            Quantity::Holonomic,
+            raw.holonomic.clone(),
+            raw.holonomic.len(),
+        ),
+        (Quantity::Forcing, raw.forcing.clone(), 0),
+        (Quantity::ConstraintDrift, raw.drift.clone(), 0),
+    ] {
+        functions.push(compile.applicable(cx, quantity, &outputs, rows)?);
+    }
+    if let Some(x) = &accelerations {
+        functions.push(compile.applicable(cx, Quantity::Accelerations, x, 0)?);
+    }
+    let functions = functions.into_iter().flatten().collect();
+    Ok(Derivation {
+        model: model.clone(),
+        mass_matrix: strings(&exact.g),
+        constraint_rows: strings(&raw.a_rows),
+        holonomic: raw.holonomic.iter().map(|h| h.to_string()).collect(),
+        accelerations: accelerations.map(|x| x.iter().map(|a| a.to_string()).collect()),
+        walls,
+        functions,
+    })
+}
+
+/// Turns expressions into the emitted functions of one model.
+struct Compiler {
+    inputs: Vec<Atom>,
+    kind: Kind,
+    /// Where a failure of the evaluator is reported.
+    span: Option<std::ops::Range<usize>>,
+}
+
+impl Compiler {
+    /// The function for `quantity` computing `outputs` (`rows` of them in
+    /// use, for rows and values).
+    fn program(
+        &self,
+        cx: &mut Collector,
+        quantity: Quantity,
+        outputs: &[Atom],
+        rows: usize,
+    ) -> Result<Function, Reported> {
+        evaluate::program(outputs, &self.inputs)
+            .map(|program| Function {
+                quantity,
+                program,
+                rows,
+            })
+            .map_err(|e| cx.error(ErrorKind::Symbolic(e), self.span.clone()))
+    }
+
+    /// As [`Compiler::program`], where the model has the quantity (an
+    /// instantaneous model has no motion and no surfaces).
+    fn applicable(
+        &self,
+        cx: &mut Collector,
+        quantity: Quantity,
+        outputs: &[Atom],
+        rows: usize,
+    ) -> Result<Option<Function>, Reported> {
+        if self.kind == Kind::Instantaneous && !quantity.spec().capability.instantaneous() {
+            return Ok(None);
+        }
+        self.program(cx, quantity, outputs, rows).map(Some)
+    }
+}
+
+/// Whether `a` is zero as a rational function.
+fn is_zero(a: &Atom) -> bool {
+    let r: Rat = a.expand().to_rational_polynomial(&Q, &Z, None);
+    r.numerator.is_zero()
+}
+
+/// Rows as an exact matrix.
+fn rows_matrix(rows: &[Vec<Rat>], n: usize, field: &Field) -> Option<Matrix<Field>> {
+    let flat: Vec<Rat> = rows.iter().flatten().cloned().collect();
+    Matrix::from_linear(flat, rows.len() as u32, n as u32, field.clone()).ok()
+}
+
+/// Entries as text.
+fn strings(m: &[Vec<Atom>]) -> Vec<Vec<String>> {
+    m.iter()
+        .map(|r| r.iter().map(|a| a.to_string()).collect())
+        .collect()
+}

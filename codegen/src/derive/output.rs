@@ -1,0 +1,124 @@
+//! What the derivation hands the emitter and front ends: plain data, no
+//! symbolic engine types. Display strings (for `derive`, `check` and the
+//! paper's comparison) and the straight-line [`Function`]s (for emission)
+//! come from the same expressions.
+
+use crate::ir::Model;
+use crate::program::{OpCount, Program};
+use crate::quantity::Quantity;
+
+/// Everything derived for one model.
+#[derive(Debug, Clone)]
+pub struct Derivation {
+    /// The validated model.
+    pub model: Model,
+    /// G, entry by entry.
+    pub mass_matrix: Vec<Vec<String>>,
+    /// Rows of A: the differentials of the holonomic constraints first.
+    pub constraint_rows: Vec<Vec<String>>,
+    /// The holonomic constraints h(q).
+    pub holonomic: Vec<String>,
+    /// q̈ in closed form, component by component, where G⁻¹ is exact and
+    /// the rows of A independent (else the run time solves numerically).
+    pub accelerations: Option<Vec<String>>,
+    /// Per wall.
+    pub walls: Vec<WallDerivation>,
+    /// The model-wide emitted functions, in [`crate::quantity::TABLE`]
+    /// order.
+    pub functions: Vec<Function>,
+}
+
+/// One emitted function: which quantity, and its program.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Function {
+    /// Which row of [`crate::quantity::TABLE`].
+    pub quantity: Quantity,
+    /// Its straight-line program over (parameters, coordinates, velocities).
+    pub program: Program,
+    /// For rows and values: how many are in use (0 otherwise).
+    pub rows: usize,
+}
+
+/// A wall's geometry.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Geometry {
+    /// A model with coordinates: the surface f(q), motion in f ≥ 0.
+    Surface(String),
+    /// An instantaneous model: the normal velocity's row.
+    NormalVelocity(Vec<String>),
+}
+
+/// How a wall's P and collision map are evaluated.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Projection {
+    /// Derived exactly and emitted as straight-line code.
+    ClosedForm {
+        /// P entry by entry.
+        projector: Vec<Vec<String>>,
+        /// v⁺ component by component, in terms of v⁻ (named as the
+        /// velocities).
+        collision: Vec<String>,
+    },
+    /// G and B are emitted and P v is solved at run time.
+    Structured,
+}
+
+/// What was derived for one wall.
+#[derive(Debug, Clone)]
+pub struct WallDerivation {
+    /// Its name.
+    pub name: String,
+    /// Its doc text.
+    pub doc: String,
+    /// Its surface (or normal velocity).
+    pub geometry: Geometry,
+    /// The independent rows of B: the normal velocity, then A's, then the
+    /// contact rows, dependent rows removed.
+    pub b_rows: Vec<Vec<String>>,
+    /// Where each kept row came from.
+    pub b_origin: Vec<String>,
+    /// The rows that were removed as dependent, with where they came from.
+    pub dropped: Vec<String>,
+    /// P and the collision map.
+    pub projection: Projection,
+    /// The wall's emitted functions, in [`crate::quantity::TABLE`] order
+    /// (the projector and collision map only in closed form).
+    pub functions: Vec<Function>,
+}
+
+impl WallDerivation {
+    /// Whether P is solved at run time.
+    pub fn structured(&self) -> bool {
+        self.projection == Projection::Structured
+    }
+
+    /// The wall's function for `q`, if it has one.
+    pub fn function(&self, q: Quantity) -> Option<&Function> {
+        self.functions.iter().find(|f| f.quantity == q)
+    }
+}
+
+impl Derivation {
+    /// The model's function for `q`, if it has one.
+    pub fn function(&self, q: Quantity) -> Option<&Function> {
+        self.functions.iter().find(|f| f.quantity == q)
+    }
+
+    /// Operation counts of every emitted function, by its name in the
+    /// generated code.
+    pub fn op_counts(&self) -> Vec<(String, OpCount)> {
+        let model = self
+            .functions
+            .iter()
+            .map(|f| (f.quantity.spec().name.to_string(), f.program.op_count()));
+        let walls = self.walls.iter().flat_map(|w| {
+            w.functions.iter().map(move |f| {
+                (
+                    format!("{}_{}", w.name, f.quantity.spec().name),
+                    f.program.op_count(),
+                )
+            })
+        });
+        model.chain(walls).collect()
+    }
+}

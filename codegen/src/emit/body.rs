@@ -1,0 +1,257 @@
+//! A straight-line program as Rust statements: inputs bound to `i{k}`,
+//! temporaries `t{k}`, outputs `o{k}`; sin and cos of one value computed by
+//! one `sincos` call.
+
+use std::collections::HashMap;
+
+use proc_macro2::{Literal, TokenStream};
+use quote::{format_ident, quote};
+
+use super::{Ctx, Scalar, ident};
+use crate::program::{Func, Instr, Program, Slot};
+
+/// `f64` or `f32`.
+pub(super) fn real(d: &Ctx) -> TokenStream {
+    match d.scalar {
+        Scalar::F64 => quote! { f64 },
+        Scalar::F32 => quote! { f32 },
+    }
+}
+
+/// A float literal of the emitted type.
+pub(super) fn lit(d: &Ctx, x: f64) -> Literal {
+    match d.scalar {
+        Scalar::F64 => Literal::f64_suffixed(x),
+        Scalar::F32 => Literal::f32_suffixed(x as f32),
+    }
+}
+
+/// libm's function `name` for the emitted type (`sin` or `sinf`).
+pub(super) fn libm_fn(d: &Ctx, name: &str) -> TokenStream {
+    let f = match d.scalar {
+        Scalar::F64 => format_ident!("{name}"),
+        Scalar::F32 => format_ident!("{name}f"),
+    };
+    quote! { ::dalembert_runtime::libm::#f }
+}
+
+/// Statements computing `o0, o1, …` from the program.
+pub(super) fn body(d: &Ctx, p: &Program) -> TokenStream {
+    let mut used = vec![false; p.inputs];
+    for ins in &p.instrs {
+        for s in sources(ins) {
+            if let Slot::Input(i) = s {
+                used[i] = true;
+            }
+        }
+    }
+    let inputs = used.iter().enumerate().filter(|(_, u)| **u).map(|(i, _)| {
+        let name = format_ident!("i{i}");
+        let value = input_value(d, i);
+        let real = real(d);
+        quote! { let #name: #real = #value; }
+    });
+    let pairs = sincos_pairs(p);
+    let stmts = p
+        .instrs
+        .iter()
+        .zip(&pairs)
+        .map(|(ins, pair)| match (ins, pair) {
+            (Instr::Fun(dst, f, src), Some(pair)) => sincos(d, p, *dst, *f, *src, *pair),
+            _ => instr(d, p, ins),
+        });
+    quote! { #(#inputs)* #(#stmts)* }
+}
+
+/// sin and cos of the same value, to be computed together by `sincos` (one
+/// argument reduction instead of two): for each instruction, the number of
+/// its pair and whether it comes first. Slots may be reassigned, so a value
+/// is a slot together with how many times it has been written before.
+fn sincos_pairs(p: &Program) -> Vec<Option<(usize, bool)>> {
+    let mut writes: HashMap<Slot, usize> = HashMap::new();
+    // (source value) → (index of its sin, index of its cos)
+    let mut calls: HashMap<(Slot, usize), (Option<usize>, Option<usize>)> = HashMap::new();
+    for (i, ins) in p.instrs.iter().enumerate() {
+        let dst = match ins {
+            Instr::Add(o, _) | Instr::Mul(o, _) | Instr::Pow(o, _, _) | Instr::Assign(o, _) => *o,
+            Instr::Fun(o, f, src) => {
+                let value = (*src, writes.get(src).copied().unwrap_or(0));
+                let entry = calls.entry(value).or_default();
+                match f {
+                    Func::Sin if entry.0.is_none() => entry.0 = Some(i),
+                    Func::Cos if entry.1.is_none() => entry.1 = Some(i),
+                    _ => {}
+                }
+                *o
+            }
+        };
+        *writes.entry(dst).or_default() += 1;
+    }
+    let mut found: Vec<(usize, usize)> = calls
+        .into_values()
+        .filter_map(|(s, c)| Some((s?, c?)))
+        .collect();
+    found.sort_unstable_by_key(|&(s, c)| s.min(c));
+    let mut out = vec![None; p.instrs.len()];
+    for (k, (s, c)) in found.into_iter().enumerate() {
+        out[s] = Some((k, s < c));
+        out[c] = Some((k, c < s));
+    }
+    out
+}
+
+/// One half of a sin/cos pair: the first computes both into `sc{k}_sin`
+/// and `sc{k}_cos`, each takes its own.
+fn sincos(
+    d: &Ctx,
+    p: &Program,
+    dst: Slot,
+    f: Func,
+    src: Slot,
+    (k, first): (usize, bool),
+) -> TokenStream {
+    let (s, c) = (format_ident!("sc{k}_sin"), format_ident!("sc{k}_cos"));
+    let real = real(d);
+    let both = first.then(|| {
+        let call = libm_fn(d, "sincos");
+        let src = slot(d, p, src);
+        quote! { let (#s, #c): (#real, #real) = #call(#src); }
+    });
+    let mine = if f == Func::Sin { s } else { c };
+    let dst = slot(d, p, dst);
+    quote! { #both let #dst: #real = #mine; }
+}
+
+fn sources(ins: &Instr) -> Vec<Slot> {
+    match ins {
+        Instr::Add(_, s) | Instr::Mul(_, s) => s.clone(),
+        Instr::Pow(_, s, _) | Instr::Fun(_, _, s) | Instr::Assign(_, s) => vec![*s],
+    }
+}
+
+/// Where input i of every program comes from: parameters, then coordinates,
+/// then velocities.
+fn input_value(d: &Ctx, i: usize) -> TokenStream {
+    let np = d.model.params.len();
+    let nq = d.model.coordinates.len();
+    if i < np {
+        let p = ident(&d.model.params[i].name);
+        quote! { self.params.#p }
+    } else if i < np + nq {
+        let k = Literal::usize_unsuffixed(i - np);
+        quote! { q[#k] }
+    } else {
+        let k = Literal::usize_unsuffixed(i - np - nq);
+        quote! { v[#k] }
+    }
+}
+
+fn slot(d: &Ctx, p: &Program, s: Slot) -> TokenStream {
+    let name = match s {
+        Slot::Input(i) => format_ident!("i{i}"),
+        Slot::Temp(i) => format_ident!("t{i}"),
+        Slot::Out(i) => format_ident!("o{i}"),
+        Slot::Const(i) => {
+            let lit = lit(d, p.consts[i]);
+            return quote! { #lit };
+        }
+    };
+    quote! { #name }
+}
+
+fn instr(d: &Ctx, p: &Program, ins: &Instr) -> TokenStream {
+    let (dst, value) = match ins {
+        Instr::Add(o, s) => (*o, join(s.iter().map(|&x| slot(d, p, x)), quote! { + })),
+        Instr::Mul(o, s) => (*o, product(d, p, s)),
+        Instr::Pow(o, s, n) => (*o, pow(d, slot(d, p, *s), *n)),
+        Instr::Fun(o, f, s) => {
+            let f = libm_fn(d, f.name());
+            let s = slot(d, p, *s);
+            (*o, quote! { #f(#s) })
+        }
+        Instr::Assign(o, s) => (*o, slot(d, p, *s)),
+    };
+    let dst = slot(d, p, dst);
+    let real = real(d);
+    quote! { let #dst: #real = #value; }
+}
+
+/// A product; a factor −1 becomes a negation.
+fn product(d: &Ctx, p: &Program, factors: &[Slot]) -> TokenStream {
+    let minus_one = |s: &Slot| matches!(s, Slot::Const(i) if p.consts[*i] == -1.0);
+    let rest: Vec<Slot> = factors.iter().copied().filter(|s| !minus_one(s)).collect();
+    let negations = factors.len() - rest.len();
+    if rest.is_empty() {
+        return if negations % 2 == 1 {
+            quote! { -1.0 }
+        } else {
+            quote! { 1.0 }
+        };
+    }
+    let prod = join(rest.iter().map(|&x| slot(d, p, x)), quote! { * });
+    if negations % 2 == 1 {
+        quote! { -(#prod) }
+    } else {
+        prod
+    }
+}
+
+/// Operands joined by an operator: `a + b + c`.
+fn join(operands: impl Iterator<Item = TokenStream>, op: TokenStream) -> TokenStream {
+    let mut out = TokenStream::new();
+    for (k, x) in operands.enumerate() {
+        if k > 0 {
+            out.extend(op.clone());
+        }
+        out.extend(x);
+    }
+    out
+}
+
+fn pow(d: &Ctx, x: TokenStream, n: i64) -> TokenStream {
+    let m = n.unsigned_abs();
+    let positive = if m == 0 {
+        quote! { 1.0 }
+    } else if m <= 8 {
+        let product = join(std::iter::repeat_n(x.clone(), m as usize), quote! { * });
+        quote! { (#product) }
+    } else {
+        let e = lit(d, m as f64);
+        let f = libm_fn(d, "pow");
+        quote! { #f(#x, #e) }
+    };
+    if n < 0 {
+        quote! { 1.0 / #positive }
+    } else {
+        positive
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// sin and cos pair up only when they take the same value: a slot
+    /// written again between them holds a different one.
+    #[test]
+    fn sincos_pairs_follow_values_not_slot_names() {
+        let (x, t) = (Slot::Input(0), Slot::Temp(0));
+        let p = Program {
+            inputs: 1,
+            consts: vec![1.0],
+            instrs: vec![
+                Instr::Add(t, vec![x, Slot::Const(0)]),
+                Instr::Fun(Slot::Out(0), Func::Sin, t),
+                Instr::Add(t, vec![x, x]),
+                Instr::Fun(Slot::Out(1), Func::Cos, t),
+                Instr::Fun(Slot::Out(2), Func::Cos, x),
+                Instr::Fun(Slot::Out(3), Func::Sin, x),
+            ],
+            outputs: 4,
+        };
+        assert_eq!(
+            sincos_pairs(&p),
+            vec![None, None, None, None, Some((0, true)), Some((0, false))]
+        );
+    }
+}

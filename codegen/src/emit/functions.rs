@@ -1,0 +1,210 @@
+//! The model's inherent functions: one per row of the quantity table that
+//! the derivation filled in, plus the structured projector and collision
+//! map where P is solved at run time.
+
+use proc_macro2::{Literal, TokenStream};
+use quote::{format_ident, quote};
+
+use super::body::{body, lit, real};
+use super::{Ctx, Scalar, doc_attr, ident};
+use crate::derive::{Function, WallDerivation};
+use crate::program::Program;
+use crate::quantity::Shape;
+
+/// `impl Model { consts, new, every function }`.
+pub(super) fn inherent_impl(d: &Ctx) -> TokenStream {
+    let ty = format_ident!("{}", d.model.type_name());
+    let (q, n) = dims(d);
+    let model_fns = d.functions.iter().map(|f| emit_function(d, f, None));
+    let walls = d.walls.iter().map(|w| wall_fns(d, w));
+    let qn = Literal::usize_unsuffixed(q);
+    let nn = Literal::usize_unsuffixed(n);
+    let init_q = d.model.initial[..q].iter().map(|x| lit(d, *x));
+    let init_v = d.model.initial[q..].iter().map(|x| lit(d, *x));
+    let real = real(d);
+    quote! {
+        impl #ty {
+            /// Number of coordinates.
+            pub const Q: usize = #qn;
+            /// Number of velocity components.
+            pub const N: usize = #nn;
+            /// The model file's initial coordinates (`[initial]`, zero where silent).
+            #[allow(clippy::approx_constant)]
+            pub const INITIAL_COORDINATES: [#real; #qn] = [#(#init_q),*];
+            /// The model file's initial velocities (`[initial]`, zero where silent).
+            #[allow(clippy::approx_constant)]
+            pub const INITIAL_VELOCITIES: [#real; #nn] = [#(#init_v),*];
+            /// The model with the given parameters.
+            pub const fn new(params: Params) -> Self {
+                Self { params }
+            }
+            #( #model_fns )*
+            #( #walls )*
+        }
+    }
+}
+
+fn wall_fns(d: &Ctx, w: &WallDerivation) -> TokenStream {
+    let fns = w
+        .functions
+        .iter()
+        .map(|f| emit_function(d, f, Some(&w.name)));
+    let structured = w.structured().then(|| structured_fns(d, w));
+    quote! { #( #fns )* #structured }
+}
+
+/// One function, as its row of the quantity table says (a wall's is named
+/// `{wall}_{name}`).
+fn emit_function(d: &Ctx, f: &Function, wall: Option<&str>) -> TokenStream {
+    let spec = f.quantity.spec();
+    let (name, doc) = match wall {
+        Some(w) => (format!("{w}_{}", spec.name), spec.doc.replace("{wall}", w)),
+        None => (spec.name.to_string(), spec.doc.to_string()),
+    };
+    let (p, with_v) = (&f.program, spec.velocities);
+    let n = d.model.velocities.len();
+    let nl = Literal::usize_unsuffixed(n);
+    let real = real(d);
+    let (ret, result) = match spec.shape {
+        Shape::Scalar => (real, quote! { o0 }),
+        Shape::Vector => {
+            let outs = padded_outputs(p, n);
+            (quote! { [#real; #nl] }, quote! { [#(#outs),*] })
+        }
+        Shape::Matrix => {
+            let rows = (0..n).map(|i| {
+                let cols = (0..n).map(move |j| format_ident!("o{}", i * n + j));
+                quote! { [#(#cols),*] }
+            });
+            (quote! { [[#real; #nl]; #nl] }, quote! { [#(#rows),*] })
+        }
+        Shape::Rows => {
+            let rows = (0..n).map(|i| {
+                if i < f.rows {
+                    let cols = (0..n).map(move |j| format_ident!("o{}", i * n + j));
+                    quote! { [#(#cols),*] }
+                } else {
+                    quote! { [0.0; #n] }
+                }
+            });
+            let array = quote! { [#(#rows),*] };
+            counted(d, "Rows", quote! { [[f32; #nl]; #nl] }, array, f.rows)
+        }
+        Shape::Values => {
+            let outs = padded_outputs(p, n);
+            let array = quote! { [#(#outs),*] };
+            counted(d, "Values", quote! { [f32; #nl] }, array, f.rows)
+        }
+    };
+    function(d, &name, &doc, p, with_v, ret, result)
+}
+
+/// P and the collision map of a wall evaluated at run time from the
+/// generated G and B by the runtime's fixed-size factorisations (NaN where
+/// B loses rank, as a closed form would divide by zero there).
+fn structured_fns(d: &Ctx, w: &WallDerivation) -> TokenStream {
+    let (q, n) = dims(d);
+    let (ql, nl) = (Literal::usize_unsuffixed(q), Literal::usize_unsuffixed(n));
+    let name = &w.name;
+    let projector = format_ident!("{name}_projector");
+    let collide = format_ident!("{name}_collide");
+    let rows = format_ident!("{name}_b_rows");
+    let p_doc = doc_attr(&format!(
+        "Wall `{name}`: the projector P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B, solved at run time from G and B (structured evaluation)."
+    ));
+    let c_doc = doc_attr(&format!(
+        "Wall `{name}`: the collision map v⁺ = v⁻ − 2G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹Bv⁻, solved at run time from G and B (structured evaluation)."
+    ));
+    quote! {
+        #p_doc
+        #[inline]
+        pub fn #projector(&self, q: &[f64; #ql]) -> [[f64; #nl]; #nl] {
+            let b = self.#rows(q);
+            ::dalembert_runtime::__private::projector(&self.mass_matrix(q), b.as_slice())
+                .unwrap_or([[f64::NAN; #nl]; #nl])
+        }
+        #c_doc
+        #[inline]
+        pub fn #collide(&self, q: &[f64; #ql], v: &[f64; #nl]) -> [f64; #nl] {
+            let b = self.#rows(q);
+            let r = b.apply(v);
+            match ::dalembert_runtime::__private::correction(&self.mass_matrix(q), b.as_slice(), r.as_slice()) {
+                Ok(d) => ::core::array::from_fn(|i| v[i] - 2.0 * d[i]),
+                Err(_) => [f64::NAN; #nl],
+            }
+        }
+    }
+}
+
+pub(super) fn dims(d: &Ctx) -> (usize, usize) {
+    (d.model.coordinates.len(), d.model.velocities.len())
+}
+
+/// `q: &[f64; Q]` and, when the function takes velocities, `v: &[f64; N]`.
+fn args(d: &Ctx, with_v: bool) -> TokenStream {
+    let (q, n) = dims(d);
+    let q = Literal::usize_unsuffixed(q);
+    let n = Literal::usize_unsuffixed(n);
+    let real = real(d);
+    if with_v {
+        quote! { q: &[#real; #q], v: &[#real; #n] }
+    } else {
+        quote! { q: &[#real; #q] }
+    }
+}
+
+/// An emitted method: doc, `#[inline]`, the arguments, the program's
+/// statements, then `result` of type `ret`.
+fn function(
+    d: &Ctx,
+    name: &str,
+    doc: &str,
+    p: &Program,
+    with_v: bool,
+    ret: TokenStream,
+    result: TokenStream,
+) -> TokenStream {
+    let f = ident(name);
+    let args = args(d, with_v);
+    let body = body(d, p);
+    let doc = doc_attr(doc);
+    quote! {
+        #doc
+        #[inline]
+        #[allow(unused_variables)]
+        pub fn #f(&self, #args) -> #ret { #body #result }
+    }
+}
+
+/// `o0, o1, …` for the program's outputs, then `0.0` up to n entries.
+fn padded_outputs(p: &Program, n: usize) -> impl Iterator<Item = TokenStream> + '_ {
+    (0..n).map(move |i| {
+        if i < p.outputs {
+            let o = format_ident!("o{i}");
+            quote! { #o }
+        } else {
+            quote! { 0.0 }
+        }
+    })
+}
+
+/// Return type and value of `k` rows or values in use out of `array`: the
+/// runtime's `Rows`/`Values` (`runtime`) in f64, `(array, k)` in f32.
+fn counted(
+    d: &Ctx,
+    runtime: &str,
+    f32_type: TokenStream,
+    array: TokenStream,
+    k: usize,
+) -> (TokenStream, TokenStream) {
+    let n = Literal::usize_unsuffixed(d.model.velocities.len());
+    let k = Literal::usize_unsuffixed(k);
+    let runtime = format_ident!("{runtime}");
+    match d.scalar {
+        Scalar::F64 => (
+            quote! { ::dalembert_runtime::#runtime<#n> },
+            quote! { ::dalembert_runtime::#runtime::new(#array, #k) },
+        ),
+        Scalar::F32 => (quote! { (#f32_type, usize) }, quote! { (#array, #k) }),
+    }
+}

@@ -1,0 +1,136 @@
+//! The runtime's capability traits for the model: `Model` and `Walls`
+//! always, `Dynamics` and `Surfaces` for a model with coordinates; the
+//! names and parameters, and one forwarding method per row of the quantity
+//! table that has one (per-wall rows dispatch on the wall).
+
+use proc_macro2::{Ident, Literal, TokenStream};
+use quote::{format_ident, quote};
+
+use super::functions::dims;
+use super::{Ctx, ident};
+use crate::ir::{Kind, camel};
+use crate::quantity::{Capability, Forward, Scope, Shape, Spec, TABLE};
+
+pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
+    let ty = format_ident!("{}", d.model.type_name());
+    let (q, n) = dims(d);
+    let name = &d.model.name;
+    let ql = Literal::usize_unsuffixed(q);
+    let nl = Literal::usize_unsuffixed(n);
+    let variants: Vec<Ident> = d
+        .walls
+        .iter()
+        .map(|w| format_ident!("{}", camel(&w.name)))
+        .collect();
+    let wall_names: Vec<&String> = d.walls.iter().map(|w| &w.name).collect();
+    let pnames: Vec<&String> = d.model.params.iter().map(|p| &p.name).collect();
+    let pidents: Vec<Ident> = d.model.params.iter().map(|p| ident(&p.name)).collect();
+    let pidx: Vec<Literal> = (0..pidents.len()).map(Literal::usize_unsuffixed).collect();
+    let coords = &d.model.coordinates;
+    let vels = &d.model.velocities;
+    let methods = |c: Capability| {
+        TABLE
+            .iter()
+            .filter(move |spec| spec.capability == c)
+            .filter_map(|spec| forward(d, spec, &variants))
+            .collect::<Vec<_>>()
+    };
+    let (model, walls) = (methods(Capability::Model), methods(Capability::Walls));
+    let model_impl = quote! {
+        impl ::dalembert_runtime::Model<#ql, #nl> for #ty {
+            type Params = Params;
+            const NAME: &'static str = #name;
+            const COORDINATES: &'static [&'static str] = &[#(#coords),*];
+            const VELOCITIES: &'static [&'static str] = &[#(#vels),*];
+            const PARAMETERS: &'static [&'static str] = &[#(#pnames),*];
+            fn with_params(params: Params) -> Self { Self { params } }
+            fn params(&self) -> &Params { &self.params }
+            fn parameter(&self, index: usize) -> Option<f64> {
+                match index { #(#pidx => Some(self.params.#pidents),)* _ => None }
+            }
+            fn set_parameter(&mut self, index: usize, value: f64) -> bool {
+                match index { #(#pidx => { self.params.#pidents = value; true })* _ => false }
+            }
+            #( #model )*
+        }
+        impl ::dalembert_runtime::Walls<#ql, #nl> for #ty {
+            type Wall = Wall;
+            const WALLS: &'static [Wall] = &[#(Wall::#variants),*];
+            fn wall_name(wall: Wall) -> &'static str {
+                match wall { #(Wall::#variants => #wall_names,)* }
+            }
+            #( #walls )*
+        }
+    };
+    if d.model.kind == Kind::Instantaneous {
+        return model_impl;
+    }
+    let (dynamics, surfaces) = (methods(Capability::Dynamics), methods(Capability::Surfaces));
+    quote! {
+        #model_impl
+        impl ::dalembert_runtime::Dynamics<#nl> for #ty {
+            const INITIAL_COORDINATES: [f64; #ql] = Self::INITIAL_COORDINATES;
+            const INITIAL_VELOCITIES: [f64; #nl] = Self::INITIAL_VELOCITIES;
+            #( #dynamics )*
+        }
+        impl ::dalembert_runtime::Surfaces<#nl> for #ty {
+            #( #surfaces )*
+        }
+    }
+}
+
+/// The trait method of one table row, forwarding to the inherent function
+/// (`None` when the row has no method, or the model lacks the function).
+fn forward(d: &Ctx, spec: &Spec, variants: &[Ident]) -> Option<TokenStream> {
+    let (method, wrap) = spec.method?;
+    let (q, n) = dims(d);
+    let (ql, nl) = (Literal::usize_unsuffixed(q), Literal::usize_unsuffixed(n));
+    let method = format_ident!("{method}");
+    let args = if spec.velocities {
+        quote! { q, v }
+    } else {
+        quote! { q }
+    };
+    let params = if spec.velocities {
+        quote! { q: &[f64; #ql], v: &[f64; #nl] }
+    } else {
+        quote! { q: &[f64; #ql] }
+    };
+    let wrapped = |call: TokenStream| match wrap {
+        Forward::Plain => call,
+        Forward::Some => quote! { Some(#call) },
+    };
+    let ty = match spec.shape {
+        Shape::Scalar => quote! { f64 },
+        Shape::Vector => quote! { [f64; #nl] },
+        Shape::Matrix => quote! { [[f64; #nl]; #nl] },
+        Shape::Rows => quote! { ::dalembert_runtime::Rows<#nl> },
+        Shape::Values => quote! { ::dalembert_runtime::Values<#nl> },
+    };
+    let ret = match wrap {
+        Forward::Plain => ty,
+        Forward::Some => quote! { Option<#ty> },
+    };
+    let (params, value) = match spec.scope {
+        Scope::Model => {
+            d.function(spec.quantity)?;
+            let f = format_ident!("{}", spec.name);
+            (params, wrapped(quote! { self.#f(#args) }))
+        }
+        Scope::Wall => {
+            let arms = d.walls.iter().zip(variants).map(|(w, v)| {
+                let f = format_ident!("{}_{}", w.name, spec.name);
+                let value = wrapped(quote! { self.#f(#args) });
+                quote! { Wall::#v => #value }
+            });
+            (
+                quote! { wall: Wall, #params },
+                quote! { match wall { #(#arms,)* } },
+            )
+        }
+    };
+    Some(quote! {
+        #[inline]
+        fn #method(&self, #params) -> #ret { #value }
+    })
+}

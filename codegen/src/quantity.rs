@@ -1,0 +1,310 @@
+//! The table of emitted quantities: one row per function a generated model
+//! has, shared by the derivation (which fills in a [`Program`] for each row)
+//! and the emitter (which writes the inherent function, the `Model` trait
+//! method that forwards to it, and its line of operation counts).
+//!
+//! Adding a quantity is one row here and its derivation in `derive/`.
+//!
+//! [`Program`]: crate::program::Program
+
+/// A function every generated model (or every wall of it) has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Quantity {
+    /// G(q).
+    MassMatrix,
+    /// T(q, v).
+    KineticEnergy,
+    /// V(q).
+    Potential,
+    /// The rows of A(q).
+    Constraints,
+    /// h(q) of the holonomic constraints.
+    Holonomic,
+    /// h(q, q̇) of G q̈ + h = Aᵀλ.
+    Forcing,
+    /// Ȧq̇.
+    ConstraintDrift,
+    /// q̈ in closed form (only where G⁻¹ is exact).
+    Accelerations,
+    /// A wall's f(q).
+    Surface,
+    /// A wall's df(q).
+    Normal,
+    /// A wall's df(q)·v.
+    NormalVelocity,
+    /// A wall's vᵀ∇²f(q)v.
+    SurfaceHessian,
+    /// A wall's independent rows of B(q).
+    WallRows,
+    /// A wall's P, in closed form.
+    Projector,
+    /// A wall's (I − 2P)v, in closed form.
+    Collide,
+}
+
+/// Whether a quantity belongs to the model or to each wall.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scope {
+    /// One function for the model.
+    Model,
+    /// One function per wall, named `{wall}_{name}`.
+    Wall,
+}
+
+/// What an emitted function returns.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shape {
+    /// One number.
+    Scalar,
+    /// N numbers (fewer outputs are padded with zeros).
+    Vector,
+    /// N×N numbers, row-major outputs.
+    Matrix,
+    /// Up to N rows of N numbers, with how many are in use.
+    Rows,
+    /// Up to N numbers, with how many are in use.
+    Values,
+}
+
+/// How the `Model` trait method returns the inherent function's value.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Forward {
+    /// As it is.
+    Plain,
+    /// Wrapped in `Some` (a trait method whose default is `None`).
+    Some,
+}
+
+/// The runtime trait a quantity's method belongs to (`dalembert_runtime`'s
+/// capability traits).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Capability {
+    /// `Model`: every model.
+    Model,
+    /// `Walls`: every model.
+    Walls,
+    /// `Dynamics`: models with coordinates.
+    Dynamics,
+    /// `Surfaces`: models with coordinates.
+    Surfaces,
+}
+
+impl Capability {
+    /// The trait's name in `dalembert_runtime`.
+    pub fn trait_name(self) -> &'static str {
+        match self {
+            Self::Model => "Model",
+            Self::Walls => "Walls",
+            Self::Dynamics => "Dynamics",
+            Self::Surfaces => "Surfaces",
+        }
+    }
+
+    /// Whether an instantaneous model (no coordinates) has it.
+    pub fn instantaneous(self) -> bool {
+        matches!(self, Self::Model | Self::Walls)
+    }
+}
+
+/// One row of the table.
+#[derive(Clone, Copy, Debug)]
+pub struct Spec {
+    /// Which quantity.
+    pub quantity: Quantity,
+    /// The inherent function's name (for a wall, after `{wall}_`).
+    pub name: &'static str,
+    /// Model-wide or per wall.
+    pub scope: Scope,
+    /// Whether it takes the velocities as well as the coordinates.
+    pub velocities: bool,
+    /// What it returns.
+    pub shape: Shape,
+    /// Its doc text; `{wall}` stands for the wall's name.
+    pub doc: &'static str,
+    /// The runtime trait whose method forwards to it; an instantaneous
+    /// model has the quantity only if it has the trait.
+    pub capability: Capability,
+    /// That method's name and how it returns the value, if it has one.
+    pub method: Option<(&'static str, Forward)>,
+}
+
+/// Every emitted quantity, in the order the generated file lists them.
+pub const TABLE: &[Spec] = &[
+    Spec {
+        quantity: Quantity::MassMatrix,
+        name: "mass_matrix",
+        scope: Scope::Model,
+        velocities: false,
+        shape: Shape::Matrix,
+        doc: "The mass matrix G(q).",
+        capability: Capability::Model,
+        method: Some(("mass_matrix", Forward::Plain)),
+    },
+    Spec {
+        quantity: Quantity::KineticEnergy,
+        name: "kinetic_energy",
+        scope: Scope::Model,
+        velocities: true,
+        shape: Shape::Scalar,
+        doc: "Kinetic energy T(q, v).",
+        capability: Capability::Model,
+        method: Some(("kinetic_energy", Forward::Plain)),
+    },
+    Spec {
+        quantity: Quantity::Potential,
+        name: "potential",
+        scope: Scope::Model,
+        velocities: false,
+        shape: Shape::Scalar,
+        doc: "Potential energy V(q).",
+        capability: Capability::Dynamics,
+        method: Some(("potential", Forward::Plain)),
+    },
+    Spec {
+        quantity: Quantity::Constraints,
+        name: "constraints",
+        scope: Scope::Model,
+        velocities: false,
+        shape: Shape::Rows,
+        doc: "Rows of A(q).",
+        capability: Capability::Model,
+        method: Some(("constraints", Forward::Plain)),
+    },
+    Spec {
+        quantity: Quantity::Holonomic,
+        name: "holonomic",
+        scope: Scope::Model,
+        velocities: false,
+        shape: Shape::Values,
+        doc: "The holonomic constraints h(q) (zero on the constraint manifold); their differentials are the first rows of A.",
+        capability: Capability::Dynamics,
+        method: Some(("holonomic", Forward::Plain)),
+    },
+    Spec {
+        quantity: Quantity::Forcing,
+        name: "forcing",
+        scope: Scope::Model,
+        velocities: true,
+        shape: Shape::Vector,
+        doc: "h(q, q̇): the equations of motion are G(q) q̈ + h(q, q̇) = A(q)ᵀλ.",
+        capability: Capability::Dynamics,
+        method: Some(("forcing", Forward::Plain)),
+    },
+    Spec {
+        quantity: Quantity::ConstraintDrift,
+        name: "constraint_drift",
+        scope: Scope::Model,
+        velocities: true,
+        shape: Shape::Vector,
+        doc: "Ȧq̇, one entry per row of A (the rest zero): A q̈ + Ȧq̇ = 0 along the motion.",
+        capability: Capability::Dynamics,
+        method: Some(("constraint_drift", Forward::Plain)),
+    },
+    Spec {
+        quantity: Quantity::Accelerations,
+        name: "accelerations",
+        scope: Scope::Model,
+        velocities: true,
+        shape: Shape::Vector,
+        doc: "q̈ of the equations of motion G(q) q̈ + h(q, q̇) = A(q)ᵀλ, A(q) q̈ + Ȧq̇ = 0, in closed form (q̇ should satisfy A(q) q̇ = 0). Non-finite where G is singular.",
+        capability: Capability::Dynamics,
+        method: Some(("closed_form_accelerations", Forward::Some)),
+    },
+    Spec {
+        quantity: Quantity::Surface,
+        name: "surface",
+        scope: Scope::Wall,
+        velocities: false,
+        shape: Shape::Scalar,
+        doc: "Wall `{wall}`: the surface function f(q).",
+        capability: Capability::Surfaces,
+        method: Some(("surface", Forward::Plain)),
+    },
+    Spec {
+        quantity: Quantity::Normal,
+        name: "normal",
+        scope: Scope::Wall,
+        velocities: false,
+        shape: Shape::Vector,
+        doc: "Wall `{wall}`: its normal df(q), the first row of B.",
+        capability: Capability::Walls,
+        method: Some(("normal", Forward::Plain)),
+    },
+    Spec {
+        quantity: Quantity::NormalVelocity,
+        name: "normal_velocity",
+        scope: Scope::Wall,
+        velocities: true,
+        shape: Shape::Scalar,
+        doc: "Wall `{wall}`: the normal velocity df(q)·v, negative while approaching.",
+        capability: Capability::Walls,
+        method: Some(("normal_velocity", Forward::Plain)),
+    },
+    Spec {
+        quantity: Quantity::SurfaceHessian,
+        name: "surface_hessian",
+        scope: Scope::Wall,
+        velocities: true,
+        shape: Shape::Scalar,
+        doc: "Wall `{wall}`: vᵀ∇²f(q)v; along a motion f̈ = df(q)·q̈ + vᵀ∇²f(q)v.",
+        capability: Capability::Surfaces,
+        method: Some(("surface_hessian", Forward::Some)),
+    },
+    Spec {
+        quantity: Quantity::WallRows,
+        name: "b_rows",
+        scope: Scope::Wall,
+        velocities: false,
+        shape: Shape::Rows,
+        doc: "Wall `{wall}`: the independent rows of B(q), the normal velocity first.",
+        capability: Capability::Walls,
+        method: Some(("wall_rows", Forward::Plain)),
+    },
+    Spec {
+        quantity: Quantity::Projector,
+        name: "projector",
+        scope: Scope::Wall,
+        velocities: false,
+        shape: Shape::Matrix,
+        doc: "Wall `{wall}`: the projector P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B.",
+        capability: Capability::Walls,
+        method: Some(("projector", Forward::Plain)),
+    },
+    Spec {
+        quantity: Quantity::Collide,
+        name: "collide",
+        scope: Scope::Wall,
+        velocities: true,
+        shape: Shape::Vector,
+        doc: "Wall `{wall}`: the collision map v⁺ = (I − 2P)v⁻.",
+        capability: Capability::Walls,
+        method: Some(("collide", Forward::Plain)),
+    },
+];
+
+impl Quantity {
+    /// Its row of [`TABLE`].
+    pub fn spec(self) -> &'static Spec {
+        TABLE
+            .iter()
+            .find(|s| s.quantity == self)
+            .expect("every quantity has a row in TABLE")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every quantity has exactly one row, and names are unique per scope.
+    #[test]
+    fn one_row_per_quantity() {
+        for (i, a) in TABLE.iter().enumerate() {
+            for b in &TABLE[i + 1..] {
+                assert_ne!(a.quantity, b.quantity);
+                assert!(a.scope != b.scope || a.name != b.name, "{}", a.name);
+            }
+            assert_eq!(a.quantity.spec().name, a.name);
+        }
+    }
+}

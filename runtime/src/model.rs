@@ -1,0 +1,133 @@
+//! The traits a generated model implements, layered by what it has (in the
+//! manner of embedded-hal): every model is a [`Model`] with [`Walls`]; a
+//! model with coordinates (`Q = N`) adds [`Dynamics`] and [`Surfaces`].
+//! An instantaneous model (`Q = 0`, the paper's §3) implements only the
+//! first two: it has no motion and no surfaces.
+
+use crate::{Rows, Values, linalg};
+
+/// What every model has: names, parameters, the mass matrix and the
+/// constraints. `Q` is the number of coordinates (0 for an instantaneous
+/// model) and `N` the number of velocity components.
+pub trait Model<const Q: usize, const N: usize> {
+    /// The model's parameters, with the model file's values as `Default`.
+    type Params: Copy + Default + core::fmt::Debug;
+
+    /// The model's name, as in its file.
+    const NAME: &'static str;
+    /// Names of the coordinates, in order (empty for an instantaneous model).
+    const COORDINATES: &'static [&'static str];
+    /// Names of the velocity components, in order.
+    const VELOCITIES: &'static [&'static str];
+    /// Names of the parameters, in order.
+    const PARAMETERS: &'static [&'static str];
+
+    /// The model with the given parameters.
+    fn with_params(params: Self::Params) -> Self;
+    /// The parameters in use.
+    fn params(&self) -> &Self::Params;
+    /// The value of parameter `index` (in [`Model::PARAMETERS`] order).
+    fn parameter(&self, index: usize) -> Option<f64>;
+    /// Sets parameter `index`; false when there is no such parameter.
+    fn set_parameter(&mut self, index: usize, value: f64) -> bool;
+
+    /// The mass matrix G(q): T = ½ vᵀ G(q) v.
+    fn mass_matrix(&self, q: &[f64; Q]) -> [[f64; N]; N];
+    /// Kinetic energy T(q, v).
+    fn kinetic_energy(&self, q: &[f64; Q], v: &[f64; N]) -> f64;
+    /// Rows of the constraints A(q): admissible v have A v = 0. In a model
+    /// with holonomic constraints the first rows are their differentials
+    /// dh(q) (see [`Dynamics::holonomic`]), the rest the nonholonomic ones.
+    fn constraints(&self, q: &[f64; Q]) -> Rows<N>;
+}
+
+/// Walls and their collision maps.
+pub trait Walls<const Q: usize, const N: usize>: Model<Q, N> {
+    /// The model's walls, one variant each.
+    type Wall: Copy + Eq + core::fmt::Debug + 'static;
+    /// Every wall of the model, in file order.
+    const WALLS: &'static [Self::Wall];
+
+    /// A wall's name, as in the model file.
+    fn wall_name(wall: Self::Wall) -> &'static str;
+    /// The wall's independent constraint rows B(q); the first is the normal
+    /// velocity.
+    fn wall_rows(&self, wall: Self::Wall, q: &[f64; Q]) -> Rows<N>;
+    /// The G-orthogonal projector P onto (ker B)^⊥ (eq. 2.4).
+    fn projector(&self, wall: Self::Wall, q: &[f64; Q]) -> [[f64; N]; N];
+    /// The collision map v⁺ = (I − 2P) v⁻ (eq. 2.13).
+    fn collide(&self, wall: Self::Wall, q: &[f64; Q], v: &[f64; N]) -> [f64; N];
+
+    /// The wall's normal row (df(q) in a model with coordinates; the first
+    /// row of B). Generated models emit it directly; the default takes B's
+    /// first row.
+    fn normal(&self, wall: Self::Wall, q: &[f64; Q]) -> [f64; N] {
+        self.wall_rows(wall, q)
+            .as_slice()
+            .first()
+            .copied()
+            .unwrap_or([0.0; N])
+    }
+
+    /// The normal velocity (df(q)·v with coordinates): negative while
+    /// approaching the wall. Generated models emit it directly; the default
+    /// is [`Walls::normal`] times v.
+    fn normal_velocity(&self, wall: Self::Wall, q: &[f64; Q], v: &[f64; N]) -> f64 {
+        linalg::dot(&self.normal(wall, q), v)
+    }
+}
+
+/// The motion between collisions of a model with coordinates: the
+/// Lagrange–d'Alembert equations G(q) q̈ + h(q, q̇) = A(q)ᵀλ, A(q) q̇ = 0.
+pub trait Dynamics<const N: usize>: Model<N, N> {
+    /// A starting configuration for simulations (the model file's
+    /// `[initial]` table).
+    const INITIAL_COORDINATES: [f64; N] = [0.0; N];
+    /// Starting velocities for simulations (the model file's `[initial]`).
+    const INITIAL_VELOCITIES: [f64; N] = [0.0; N];
+
+    /// Potential energy V(q).
+    fn potential(&self, q: &[f64; N]) -> f64;
+    /// The holonomic constraints' values h(q) (zero on the constraint
+    /// manifold). None unless the model file declares `holonomic`.
+    fn holonomic(&self, q: &[f64; N]) -> Values<N> {
+        let _ = q;
+        Values::EMPTY
+    }
+    /// h(q, q̇) in G(q) q̈ + h(q, q̇) = A(q)ᵀλ. See
+    /// [`crate::dynamics::accelerations`].
+    fn forcing(&self, q: &[f64; N], v: &[f64; N]) -> [f64; N];
+    /// Ȧq̇, one entry per row of A, the rest zero: along the motion
+    /// A q̈ + Ȧq̇ = 0.
+    fn constraint_drift(&self, q: &[f64; N], v: &[f64; N]) -> [f64; N];
+
+    /// q̈ of the equations of motion in closed form, where the generator
+    /// derived one (G⁻¹ exact); `None` (the default) means "solve
+    /// G q̈ + h = Aᵀλ numerically", as [`crate::dynamics::accelerations`]
+    /// does. The result is non-finite where G is singular.
+    fn closed_form_accelerations(&self, q: &[f64; N], v: &[f64; N]) -> Option<[f64; N]> {
+        let _ = (q, v);
+        None
+    }
+
+    /// Total energy T + V.
+    fn energy(&self, q: &[f64; N], v: &[f64; N]) -> f64 {
+        self.kinetic_energy(q, v) + self.potential(q)
+    }
+}
+
+/// The walls of a model with coordinates as surfaces N = {f(q) = 0}: what
+/// the hybrid simulator needs on top of [`Dynamics`] and [`Walls`].
+pub trait Surfaces<const N: usize>: Dynamics<N> + Walls<N, N> {
+    /// The wall's surface function f(q): motion in f ≥ 0, the wall is f = 0.
+    fn surface(&self, wall: Self::Wall, q: &[f64; N]) -> f64;
+
+    /// vᵀ∇²f(q)v for the wall's surface f: along a motion the second time
+    /// derivative of f is f̈ = df(q)·q̈ + vᵀ∇²f(q)v. The simulator uses it to
+    /// end steps where a collision is predicted. Generated models emit it;
+    /// the default `None` (unknown) means steps are not aimed at this wall.
+    fn surface_hessian(&self, wall: Self::Wall, q: &[f64; N], v: &[f64; N]) -> Option<f64> {
+        let _ = (wall, q, v);
+        None
+    }
+}

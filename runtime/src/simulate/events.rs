@@ -1,0 +1,284 @@
+//! Events on a step: where the motion is predicted to meet a wall (so that
+//! adaptive steps end there), and where a step actually crosses one,
+//! located on the dense output.
+
+use super::integrator::{Method, Trial};
+use super::phase::Phase;
+use super::thresholds::{ROOT_ITERATIONS, SHORTEST_AIM_ULPS};
+use super::{SimError, Simulator};
+use crate::{Surfaces, libm, linalg};
+
+/// A collision predicted from f's second-order Taylor polynomial.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Aim {
+    /// Index into `M::WALLS`.
+    pub wall: usize,
+    /// How long from now.
+    pub tau: f64,
+}
+
+/// A wall crossed on a step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Crossing {
+    /// Index into `M::WALLS`.
+    pub wall: usize,
+    /// When, on the dense output.
+    pub t: f64,
+}
+
+impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
+    /// The wall the motion from y0 is predicted to meet first and when, from
+    /// f's second-order Taylor polynomial in time (adaptive integrator
+    /// only): the next step is made to end there. A motion whose f is
+    /// quadratic in time (a flight in uniform gravity to a plane) then meets
+    /// the wall at the end of one step, with no step across it to redo; for
+    /// other motions the prediction only shortens a step, and the crossing
+    /// is found on the step as usual.
+    pub(super) fn aim(&self, y0: &Phase<N>) -> Option<Aim> {
+        if !self.settings.integrator.adaptive() {
+            return None;
+        }
+        let m = self.model;
+        let shortest = SHORTEST_AIM_ULPS * f64::EPSILON * self.state.t.abs().max(1.0);
+        let mut best: Option<Aim> = None;
+        for (k, &wall) in M::WALLS.iter().enumerate() {
+            let Some(hessian) = m.surface_hessian(wall, &y0.q, &y0.v) else {
+                continue;
+            };
+            let f = m.surface(wall, &y0.q);
+            let normal = m.normal(wall, &y0.q);
+            let rate = linalg::dot(&normal, &y0.v);
+            let accel = linalg::dot(&normal, &self.f0.v) + hessian;
+            if let Some(tau) = descending_root(f, rate, accel)
+                && tau > shortest
+                && best.is_none_or(|b| tau < b.tau)
+            {
+                best = Some(Aim { wall: k, tau });
+            }
+        }
+        best
+    }
+
+    /// The first wall crossed on the step (index into `M::WALLS`, time on
+    /// the dense output), if any.
+    pub(super) fn first_crossing(
+        &mut self,
+        y0: &Phase<N>,
+        trial: &Trial<N>,
+        t0: f64,
+        h: f64,
+    ) -> Result<Option<Crossing>, SimError<M::Wall>> {
+        let mut best: Option<Crossing> = None;
+        let mut second: Option<Crossing> = None;
+        for k in 0..M::WALLS.len() {
+            let Some(theta) = self.wall_crossing(k, y0, trial, t0, h)? else {
+                continue;
+            };
+            let now = Crossing {
+                wall: k,
+                t: t0 + theta * h,
+            };
+            match best {
+                Some(b) if b.t <= now.t => {
+                    if second.is_none_or(|s| now.t < s.t) {
+                        second = Some(now);
+                    }
+                }
+                _ => {
+                    second = best;
+                    best = Some(now);
+                }
+            }
+        }
+        if let (Some(a), Some(b)) = (best, second)
+            && b.t - a.t <= self.settings.simultaneous
+        {
+            return Err(SimError::Simultaneous {
+                first: M::WALLS[a.wall],
+                second: M::WALLS[b.wall],
+                t: a.t,
+            });
+        }
+        Ok(best)
+    }
+
+    /// Where on the step (θ ∈ [0, 1]) wall `k` is first met, if it is.
+    ///
+    /// f and its rate df·q̇ are sampled on the dense output. Met means f
+    /// goes from > 0 to ≤ 0 between samples; a dip below zero between two
+    /// positive samples is caught by the rate changing sign (its bottom is
+    /// located first). A wall just collided with starts at f ≈ 0 moving
+    /// away: it is met again only after f has been positive, which is also
+    /// checked between samples through the top of the excursion.
+    fn wall_crossing(
+        &self,
+        k: usize,
+        y0: &Phase<N>,
+        trial: &Trial<N>,
+        t0: f64,
+        h: f64,
+    ) -> Result<Option<f64>, SimError<M::Wall>> {
+        let m = self.model;
+        let wall = M::WALLS[k];
+        let state = |theta: f64| -> Phase<N> {
+            if theta == 0.0 {
+                *y0
+            } else if theta == 1.0 {
+                trial.y1
+            } else {
+                trial.dense.at(theta, h)
+            }
+        };
+        let f = |theta: f64| {
+            let q = if theta == 0.0 {
+                y0.q
+            } else if theta == 1.0 {
+                trial.y1.q
+            } else {
+                trial.dense.position(theta, h)
+            };
+            m.surface(wall, &q)
+        };
+        let rate = |theta: f64| {
+            let y = state(theta);
+            m.normal_velocity(wall, &y.q, &y.v)
+        };
+        // One dense-output evaluation per sample for both f and its rate.
+        let sample = |theta: f64| {
+            let y = state(theta);
+            (
+                theta,
+                m.surface(wall, &y.q),
+                m.normal_velocity(wall, &y.q, &y.v),
+            )
+        };
+        let n = self.settings.samples + 1;
+        let mut prev = sample(0.0);
+        let mut leaving = self.departing & (1 << k) != 0 && prev.1 <= 0.0 && prev.2 > 0.0;
+        if !leaving && prev.1 <= 0.0 {
+            // At or beyond the wall at the step's start and not leaving it
+            // (a projection can move q by rounding-sized amounts).
+            return Ok(Some(0.0));
+        }
+        for j in 1..=n {
+            let now = sample(j as f64 / n as f64);
+            if leaving {
+                if now.1 > 0.0 {
+                    leaving = false;
+                } else if now.2 <= 0.0 {
+                    // Turned back before a sample saw it off the wall: find
+                    // the top of the excursion.
+                    let top = illinois(&rate, (prev.0, prev.2), (now.0, now.2));
+                    let f_top = f(top);
+                    if f_top > 0.0 {
+                        return Ok(Some(illinois(&f, (top, f_top), (now.0, now.1))));
+                    }
+                    return Err(SimError::Grazing {
+                        wall,
+                        t: t0 + top * h,
+                        normal_velocity: rate(top),
+                    });
+                }
+            } else if now.1 <= 0.0 {
+                return Ok(Some(illinois(&f, (prev.0, prev.1), (now.0, now.1))));
+            } else if prev.2 < 0.0 && now.2 > 0.0 {
+                // f stays positive at both samples but turns: check the
+                // bottom of the dip.
+                let falling = |theta: f64| -rate(theta);
+                let bottom = illinois(&falling, (prev.0, -prev.2), (now.0, -now.2));
+                let f_bottom = f(bottom);
+                if f_bottom <= 0.0 {
+                    return Ok(Some(illinois(&f, (prev.0, prev.1), (bottom, f_bottom))));
+                }
+            }
+            prev = now;
+        }
+        Ok(None)
+    }
+}
+
+/// The first τ > 0 at which f + rate·τ + accel·τ²/2 falls through zero
+/// (its slope there negative), if there is one.
+fn descending_root(f: f64, rate: f64, accel: f64) -> Option<f64> {
+    // The descending root is (−rate − s)/accel with s = √(rate² − 2·accel·f);
+    // for rate ≤ 0 the same value in the form 2f/(s − rate), which does not
+    // cancel (and covers accel = 0).
+    let disc = rate * rate - 2.0 * accel * f;
+    if disc.is_nan() || disc < 0.0 {
+        return None;
+    }
+    let s = libm::sqrt(disc);
+    let tau = if rate > 0.0 {
+        (-rate - s) / accel
+    } else {
+        2.0 * f / (s - rate)
+    };
+    (tau > 0.0 && tau.is_finite()).then_some(tau)
+}
+
+/// The root of `f` in [a, b] with f(a) > 0 ≥ f(b), by the Illinois variant
+/// of regula falsi; returns θ.
+fn illinois(f: &impl Fn(f64) -> f64, a: (f64, f64), b: (f64, f64)) -> f64 {
+    let ((mut a, mut fa), (mut b, mut fb)) = (a, b);
+    let mut side = 0;
+    for _ in 0..ROOT_ITERATIONS {
+        if fb == 0.0 || b - a <= 2.0 * f64::EPSILON * b.abs().max(1e-300) {
+            break;
+        }
+        let mut c = (a * fb - b * fa) / (fb - fa);
+        if !(c > a && c < b) {
+            c = 0.5 * (a + b);
+        }
+        let fc = f(c);
+        if fc > 0.0 {
+            a = c;
+            fa = fc;
+            if side == 1 {
+                fb *= 0.5;
+            }
+            side = 1;
+        } else {
+            b = c;
+            fb = fc;
+            if side == -1 {
+                fa *= 0.5;
+            }
+            side = -1;
+        }
+    }
+    b
+}
+
+#[cfg(test)]
+mod tests {
+    use super::descending_root;
+
+    fn close(a: Option<f64>, b: f64) -> bool {
+        a.is_some_and(|a| (a - b).abs() <= 1e-14 * b.abs())
+    }
+
+    #[test]
+    fn descending_roots() {
+        // Thrown up from the wall: back after 2·rate/|accel|, not at the
+        // start (where f rises through zero), also a rounding below it.
+        assert!(close(descending_root(0.0, 2.0, -10.0), 0.4));
+        assert!(close(descending_root(-1e-17, 2.0, -10.0), 0.4));
+        // Falling from height 5 at rest: √(2·5/10) = 1.
+        assert!(close(descending_root(5.0, 0.0, -10.0), 1.0));
+        // Approaching at constant speed: f/|rate|.
+        assert!(close(descending_root(3.0, -2.0, 0.0), 1.5));
+        // Approaching while pushed back: the earlier of the two roots of
+        // 1 − 3τ + τ² (τ = (3 − √5)/2), not the later one where f rises.
+        assert!(close(
+            descending_root(1.0, -3.0, 2.0),
+            (3.0 - 5f64.sqrt()) / 2.0
+        ));
+        // Turning back before the wall, moving away, or already beyond it
+        // and approaching: no meeting ahead.
+        assert_eq!(descending_root(1.0, -1.0, 2.0), None);
+        assert_eq!(descending_root(1.0, 1.0, 0.0), None);
+        assert_eq!(descending_root(1.0, 1.0, 2.0), None);
+        assert_eq!(descending_root(-1.0, -1.0, 0.0), None);
+        assert_eq!(descending_root(f64::NAN, -1.0, 0.0), None);
+    }
+}

@@ -1,0 +1,61 @@
+//! Dense output: the motion on one step, for any time inside it.
+
+use super::super::phase::Phase;
+
+/// The motion on one step, for any time inside it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Dense<const N: usize> {
+    /// Cubic Hermite through (y₀, f₀) and (y₁, f₁) (RK4).
+    Hermite {
+        y0: Phase<N>,
+        y1: Phase<N>,
+        f0: Phase<N>,
+        f1: Phase<N>,
+    },
+    /// Shampine's continuous extension of Dormand–Prince (Hairer–Nørsett–
+    /// Wanner, *Solving ODEs I*, §II.6):
+    /// y₀ + θ(r₁ + (1−θ)(r₂ + θ(r₃ + (1−θ)r₄))).
+    Shampine { y0: Phase<N>, r: [Phase<N>; 4] },
+}
+
+impl<const N: usize> Dense<N> {
+    /// One half of the interpolated state at θ ∈ [0, 1] of a step of length
+    /// `h`: `part` picks q or v out of each stored (q, v) pair.
+    fn interpolate(&self, theta: f64, h: f64, part: fn(&Phase<N>) -> &[f64; N]) -> [f64; N] {
+        match self {
+            Dense::Hermite { y0, y1, f0, f1 } => {
+                // y₀ + θ(y₁−y₀) + θ(θ−1)[(1−2θ)(y₁−y₀) + (θ−1)h f₀ + θ h f₁]
+                let c = theta * (theta - 1.0);
+                let (a, b, fa, fb) = (part(y0), part(y1), part(f0), part(f1));
+                core::array::from_fn(|i| {
+                    let d = b[i] - a[i];
+                    a[i] + theta * d
+                        + c * ((1.0 - 2.0 * theta) * d
+                            + (theta - 1.0) * h * fa[i]
+                            + theta * h * fb[i])
+                })
+            }
+            Dense::Shampine { y0, r } => {
+                let s = 1.0 - theta;
+                let (a, r) = (part(y0), r.each_ref().map(part));
+                core::array::from_fn(|i| {
+                    a[i] + theta * (r[0][i] + s * (r[1][i] + theta * (r[2][i] + s * r[3][i])))
+                })
+            }
+        }
+    }
+
+    /// The interpolated coordinates alone (half the work of [`Dense::at`];
+    /// a wall's f needs no more).
+    pub fn position(&self, theta: f64, h: f64) -> [f64; N] {
+        self.interpolate(theta, h, |y| &y.q)
+    }
+
+    /// The interpolated state at θ ∈ [0, 1] of a step of length `h`.
+    pub fn at(&self, theta: f64, h: f64) -> Phase<N> {
+        Phase {
+            q: self.interpolate(theta, h, |y| &y.q),
+            v: self.interpolate(theta, h, |y| &y.v),
+        }
+    }
+}

@@ -1,0 +1,128 @@
+//! Integration methods between collisions. Each is one file with its
+//! tableau, its dense output and its step-size control, and implements
+//! [`Method`]; [`Integrator`] names them in [`super::Settings`].
+//!
+//! Adding a method: a file here implementing [`Method`], a variant of
+//! [`Integrator`], and its arm in `with_method!`.
+
+mod dense;
+mod dopri;
+mod rk4;
+
+pub(crate) use dense::Dense;
+pub use dopri::DormandPrince;
+pub use rk4::Rk4;
+
+use super::phase::Phase;
+
+/// The integration method between collisions.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Integrator {
+    /// Classical fourth-order Runge–Kutta with a fixed step.
+    Rk4(Rk4),
+    /// Dormand–Prince 5(4) with error control.
+    DormandPrince(DormandPrince),
+}
+
+/// One trial step: the new state, its derivative, the error estimate (zero
+/// for a method without one) and the dense output.
+pub(crate) struct Trial<const N: usize> {
+    pub y1: Phase<N>,
+    pub f1: Phase<N>,
+    pub error: f64,
+    pub dense: Dense<N>,
+}
+
+/// What the simulator needs of a method. `f` evaluates (q̇, q̈) at a time
+/// and state; its error type is the simulator's.
+pub(crate) trait Method {
+    /// Whether the settings are usable (positive, finite steps and
+    /// tolerances).
+    fn valid(&self) -> bool;
+
+    /// Whether steps are chosen by error control (and so can be aimed at
+    /// predicted collisions and retried when too long).
+    fn adaptive(&self) -> bool;
+
+    /// The first step from y, where the derivative is f0.
+    fn initial_step<const N: usize>(&self, y: &Phase<N>, f0: &Phase<N>) -> f64;
+
+    /// The longest step allowed.
+    fn max_step(&self) -> f64;
+
+    /// The factor by which the step changes after a trial with scaled
+    /// error `err` (adaptive methods; 1 otherwise).
+    fn factor(&self, err: f64) -> f64;
+
+    /// The end of one step of length `h` from (t0, y0), and the derivative
+    /// there when the method has it for free; no error estimate, no dense
+    /// output.
+    fn advance<const N: usize, E>(
+        &self,
+        f: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
+        y0: &Phase<N>,
+        f0: &Phase<N>,
+        t0: f64,
+        h: f64,
+    ) -> Result<(Phase<N>, Option<Phase<N>>), E>;
+
+    /// One step of length `h` from (t0, y0), with its error estimate and
+    /// dense output, and without error control.
+    fn trial<const N: usize, E>(
+        &self,
+        f: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
+        y0: &Phase<N>,
+        f0: &Phase<N>,
+        t0: f64,
+        h: f64,
+    ) -> Result<Trial<N>, E>;
+}
+
+/// `$body` with `$m` bound to the method of `$integrator`: the one place
+/// where the integrators are listed.
+macro_rules! with_method {
+    ($integrator:expr, $m:ident => $body:expr) => {
+        match $integrator {
+            Integrator::Rk4($m) => $body,
+            Integrator::DormandPrince($m) => $body,
+        }
+    };
+}
+
+impl Method for Integrator {
+    fn valid(&self) -> bool {
+        with_method!(self, m => m.valid())
+    }
+    fn adaptive(&self) -> bool {
+        with_method!(self, m => m.adaptive())
+    }
+    fn initial_step<const N: usize>(&self, y: &Phase<N>, f0: &Phase<N>) -> f64 {
+        with_method!(self, m => m.initial_step(y, f0))
+    }
+    fn max_step(&self) -> f64 {
+        with_method!(self, m => m.max_step())
+    }
+    fn factor(&self, err: f64) -> f64 {
+        with_method!(self, m => m.factor(err))
+    }
+    fn advance<const N: usize, E>(
+        &self,
+        f: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
+        y0: &Phase<N>,
+        f0: &Phase<N>,
+        t0: f64,
+        h: f64,
+    ) -> Result<(Phase<N>, Option<Phase<N>>), E> {
+        with_method!(self, m => m.advance(f, y0, f0, t0, h))
+    }
+    fn trial<const N: usize, E>(
+        &self,
+        f: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
+        y0: &Phase<N>,
+        f0: &Phase<N>,
+        t0: f64,
+        h: f64,
+    ) -> Result<Trial<N>, E> {
+        with_method!(self, m => m.trial(f, y0, f0, t0, h))
+    }
+}

@@ -1,0 +1,77 @@
+//! Classical fourth-order Runge–Kutta with a fixed step, cubic Hermite
+//! dense output.
+
+use super::super::phase::Phase;
+use super::{Dense, Method, Trial};
+
+/// Classical fourth-order Runge–Kutta with a fixed step (the last step
+/// before the horizon is shortened to end on it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rk4 {
+    /// The step.
+    pub step: f64,
+}
+
+const WEIGHTS: [f64; 4] = [1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
+
+impl Method for Rk4 {
+    fn valid(&self) -> bool {
+        self.step > 0.0 && self.step.is_finite()
+    }
+
+    fn adaptive(&self) -> bool {
+        false
+    }
+
+    fn initial_step<const N: usize>(&self, _: &Phase<N>, _: &Phase<N>) -> f64 {
+        self.step
+    }
+
+    fn max_step(&self) -> f64 {
+        self.step
+    }
+
+    fn factor(&self, _: f64) -> f64 {
+        1.0
+    }
+
+    fn advance<const N: usize, E>(
+        &self,
+        f: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
+        y0: &Phase<N>,
+        f0: &Phase<N>,
+        t0: f64,
+        h: f64,
+    ) -> Result<(Phase<N>, Option<Phase<N>>), E> {
+        let mut k = [Phase::ZERO; 4];
+        k[0] = *f0;
+        k[1] = f(t0 + h / 2.0, &y0.plus(h, &[(0.5, &k[0])]))?;
+        k[2] = f(t0 + h / 2.0, &y0.plus(h, &[(0.5, &k[1])]))?;
+        k[3] = f(t0 + h, &y0.plus(h, &[(1.0, &k[2])]))?;
+        let terms: [(f64, &Phase<N>); 4] = core::array::from_fn(|j| (WEIGHTS[j], &k[j]));
+        Ok((y0.plus(h, &terms), None))
+    }
+
+    fn trial<const N: usize, E>(
+        &self,
+        f: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
+        y0: &Phase<N>,
+        f0: &Phase<N>,
+        t0: f64,
+        h: f64,
+    ) -> Result<Trial<N>, E> {
+        let (y1, _) = self.advance(f, y0, f0, t0, h)?;
+        let f1 = f(t0 + h, &y1)?;
+        Ok(Trial {
+            y1,
+            f1,
+            error: 0.0,
+            dense: Dense::Hermite {
+                y0: *y0,
+                y1,
+                f0: *f0,
+                f1,
+            },
+        })
+    }
+}

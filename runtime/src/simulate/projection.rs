@@ -1,0 +1,88 @@
+//! Back onto the constraints: q onto h(q) = 0 and q̇ onto ker A(q), in the
+//! metric of G; residuals and admissible velocities for callers.
+
+use super::phase::{Phase, norm};
+use super::thresholds::{HOLONOMIC_DONE_ULPS, HOLONOMIC_FAILED, HOLONOMIC_STEPS};
+use super::{Residual, SimError, Simulator};
+use crate::linalg::{self, ProjectorError};
+use crate::{Dynamics, Surfaces};
+
+impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
+    /// q onto h(q) = 0 (Gauss–Newton in the metric of G), then q̇ onto
+    /// ker A(q) (G-orthogonally). Recomputes (q̇, q̈) when anything moved.
+    pub(super) fn project(&mut self) -> Result<(), SimError<M::Wall>> {
+        if !self.settings.project {
+            return Ok(());
+        }
+        let m = self.model;
+        let t = self.state.t;
+        let fail = |error| SimError::Projection { t, error };
+        let mut moved = false;
+        let h = m.holonomic(&self.state.q);
+        if !h.as_slice().is_empty() {
+            let mut q = self.state.q;
+            let mut r = h;
+            let mut done = false;
+            for _ in 0..HOLONOMIC_STEPS {
+                if r.max_abs() <= HOLONOMIC_DONE_ULPS * f64::EPSILON * (1.0 + norm(&q)) {
+                    done = true;
+                    break;
+                }
+                let g = m.mass_matrix(&q);
+                let a = m.constraints(&q);
+                let rows = &a.as_slice()[..r.as_slice().len()];
+                let d = linalg::correction(&g, rows, r.as_slice()).map_err(fail)?;
+                for (qi, di) in q.iter_mut().zip(d) {
+                    *qi -= di;
+                }
+                r = m.holonomic(&q);
+                moved = true;
+            }
+            if !done && r.max_abs() > HOLONOMIC_FAILED * (1.0 + norm(&q)) {
+                return Err(fail(ProjectorError::DependentRows));
+            }
+            self.state.q = q;
+        }
+        let a = m.constraints(&self.state.q);
+        if !a.is_empty() {
+            let g = m.mass_matrix(&self.state.q);
+            let r = a.apply(&self.state.v);
+            let d = linalg::correction(&g, a.as_slice(), r.as_slice()).map_err(fail)?;
+            for (vi, di) in self.state.v.iter_mut().zip(d) {
+                *vi -= di;
+            }
+            moved = true;
+        }
+        if moved {
+            let y = Phase {
+                q: self.state.q,
+                v: self.state.v,
+            };
+            self.f0 = self.rhs(t, &y)?;
+        }
+        Ok(())
+    }
+}
+
+/// Constraint residuals of model `m` at (q, v).
+pub fn residual<M: Dynamics<N>, const N: usize>(m: &M, q: &[f64; N], v: &[f64; N]) -> Residual {
+    Residual {
+        velocity: m.constraints(q).apply(v).max_abs(),
+        position: m.holonomic(q).max_abs(),
+    }
+}
+
+/// The admissible velocity nearest to `v` in the metric of G(q): v minus its
+/// G-orthogonal component off ker A(q). Use it to build initial states.
+pub fn admissible<M: Dynamics<N>, const N: usize>(
+    m: &M,
+    q: &[f64; N],
+    v: &[f64; N],
+) -> Result<[f64; N], ProjectorError> {
+    let a = m.constraints(q);
+    if a.is_empty() {
+        return Ok(*v);
+    }
+    let d = linalg::correction(&m.mass_matrix(q), a.as_slice(), a.apply(v).as_slice())?;
+    Ok(core::array::from_fn(|i| v[i] - d[i]))
+}

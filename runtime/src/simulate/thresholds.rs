@@ -1,0 +1,54 @@
+//! Every numerical threshold of the simulator, in one place, with what it
+//! is for. Tolerances of the integrators themselves are in
+//! [`super::Settings`]; these are the simulator's own judgements.
+
+/// Most walls a model may have: the simulator keeps the walls just left in
+/// a 64-bit mask (more are refused with [`super::SimError::TooManyWalls`]).
+pub const MAX_WALLS: usize = 64;
+
+/// A starting state is admissible when |A q̇| and |h(q)| are at most this
+/// times (1 + |q| + |q̇|).
+pub const ADMISSIBLE: f64 = 1e-8;
+
+/// A starting state is on a wall (not beyond it) while f ≥ −this times
+/// (1 + |q| + |q̇|).
+pub const ON_WALL: f64 = 1e-12;
+
+/// A Newton or Taylor correction from a point on a step of length h is
+/// trusted up to this fraction of h (its error is O(δ³) in q, O(δ²) in q̇).
+pub const TAYLOR_REACH: f64 = 1e-6;
+
+/// Newton steps on f at most when a collision is polished.
+pub const POLISH_STEPS: usize = 6;
+
+/// The collision map must reverse the normal velocity to this relative
+/// accuracy, or B has lost rank there ([`super::SimError::SingularWall`]).
+pub const REVERSAL: f64 = 1e-6;
+
+/// An aimed step is not shorter than this many ulps of t.
+pub const SHORTEST_AIM_ULPS: f64 = 16.0;
+
+/// A step of at most this many ulps of t (not ending the run) is
+/// [`super::SimError::StepTooSmall`].
+pub const SMALLEST_STEP_ULPS: f64 = 4.0;
+
+/// An adaptive step whose stages meet a singular or non-finite state is
+/// shrunk by [`FAILED_STEP_SHRINK`] at most this many times before the
+/// error is reported.
+pub const FAILED_STEP_RETRIES: u32 = 8;
+
+/// See [`FAILED_STEP_RETRIES`].
+pub const FAILED_STEP_SHRINK: f64 = 0.2;
+
+/// Gauss–Newton steps at most onto h(q) = 0 per projection.
+pub const HOLONOMIC_STEPS: usize = 8;
+
+/// h(q) counts as zero below this many ulps of (1 + |q|).
+pub const HOLONOMIC_DONE_ULPS: f64 = 4.0;
+
+/// After [`HOLONOMIC_STEPS`], |h(q)| above this times (1 + |q|) is a
+/// failed projection.
+pub const HOLONOMIC_FAILED: f64 = 1e-10;
+
+/// Iterations at most of the Illinois root finder on the dense output.
+pub const ROOT_ITERATIONS: usize = 200;
