@@ -6,6 +6,7 @@
 //! `check` compares a derivation with a reference file; `simulate` runs a
 //! built-in model through collisions and writes its trajectory and a plot.
 
+mod plot;
 mod sim;
 
 use std::path::{Path, PathBuf};
@@ -150,15 +151,15 @@ fn paper(models: &Path) -> Result<bool, String> {
         all_ok &= report(&d, &r, &c);
         println!();
     }
-    pendulum_demo();
+    section_3_2_1_collision_map();
     println!();
-    Ok(all_ok && simulated_pendulum()?)
+    Ok(all_ok && section_3_2_1_simulated()?)
 }
 
 /// §3.2.1 simulated: the ball in flight (`models/ball_bounce.toml`) from the
 /// model file's initial state (just after a bounce, u = 2, v = 1) through
 /// 20 bounces, written to target/simulate/.
-fn simulated_pendulum() -> Result<bool, String> {
+fn section_3_2_1_simulated() -> Result<bool, String> {
     println!(
         "==================== §3.2.1 simulated: 20 bounces of ball_bounce ===================="
     );
@@ -185,7 +186,7 @@ fn simulated_pendulum() -> Result<bool, String> {
 
 /// §3.2.1 with the generated code itself: the paper's initial data must
 /// come back reversed.
-fn pendulum_demo() {
+fn section_3_2_1_collision_map() {
     let ball = BallFloor::default();
     let p = ball.params;
     let (v, u) = (1.5, 2.0);

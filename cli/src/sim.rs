@@ -10,10 +10,12 @@ use dalembert::for_each_model;
 use dalembert::models::*;
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
-    DormandPrince, Integrator, Rk4, Settings, Simulator, State, Step, admissible, residual,
+    DormandPrince, Integrator, Residual, Rk4, Settings, Simulator, State, Step, admissible,
+    residual,
 };
 use indicatif::{ProgressBar, ProgressStyle};
-use plotters::prelude::*;
+
+use crate::plot::plot;
 
 /// The integration method.
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -26,8 +28,8 @@ pub enum Method {
 
 #[derive(Args, Debug)]
 pub struct SimulateArgs {
-    /// A built-in model with coordinates: ball_bounce, ball_wall_euler,
-    /// pendulum_wall, masses_on_line, puck.
+    /// A built-in model with coordinates (listed below).
+    #[arg(long_help = models_help())]
     pub model: String,
     /// Simulate from t = 0 to this time.
     #[arg(long, default_value_t = 5.0)]
@@ -58,6 +60,19 @@ pub struct SimulateArgs {
     /// Directory for `<model>.csv` and `<model>.svg`.
     #[arg(long, default_value = "target/simulate")]
     pub out: PathBuf,
+}
+
+/// The built-in models with coordinates, for `--help`.
+fn models_help() -> String {
+    let mut names: Vec<&str> = Vec::new();
+    macro_rules! with_coordinates {
+        ($module:ident, $ty:ident, 0, $n:literal) => {};
+        ($module:ident, $ty:ident, $q:literal, $n:literal) => {
+            names.push(stringify!($module));
+        };
+    }
+    for_each_model!(with_coordinates);
+    format!("A built-in model with coordinates: {}", names.join(", "))
 }
 
 fn assignment(s: &str) -> Result<(String, f64), String> {
@@ -104,16 +119,59 @@ pub fn simulate(args: &SimulateArgs) -> Result<bool, String> {
 }
 
 /// One output row.
-struct Row<const N: usize> {
-    t: f64,
-    q: [f64; N],
-    v: [f64; N],
-    energy: f64,
-    residual: [f64; 2],
-    event: Option<&'static str>,
+pub struct Row<const N: usize> {
+    pub t: f64,
+    pub q: [f64; N],
+    pub v: [f64; N],
+    pub energy: f64,
+    pub residual: [f64; 2],
+    pub event: Option<&'static str>,
 }
 
 fn run<M: Surfaces<N>, const N: usize>(args: &SimulateArgs) -> Result<bool, String> {
+    let (model, start, start_residual) = start::<M, N>(args)?;
+    let mut sim = Simulator::new(&model, start, settings(args)).map_err(|e| e.to_string())?;
+    let every = args.every.unwrap_or(args.t_end / 2000.0);
+    if !(every > 0.0 && args.t_end > 0.0) {
+        return Err("--t-end and --every must be positive".into());
+    }
+    let e0 = model.energy(&start.q, &start.v);
+    let mut rows = vec![Row {
+        t: 0.0,
+        q: start.q,
+        v: start.v,
+        energy: e0,
+        residual: [start_residual.velocity, start_residual.position],
+        event: None,
+    }];
+    let clock = Instant::now();
+    let failure = integrate(&mut sim, args.t_end, every, &mut rows)?;
+    let elapsed = clock.elapsed();
+
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
+    let csv = args.out.join(format!("{}.csv", M::NAME));
+    let svg = args.out.join(format!("{}.svg", M::NAME));
+    write_csv::<M, N>(&csv, &rows)?;
+    let path = path_axes::<M, N>(args.path.as_deref())?;
+    plot::<M, N>(&svg, &rows, path, e0)?;
+    summary(&sim, args, &rows, e0, elapsed.as_secs_f64());
+    println!("  trajectory: {}", csv.display());
+    println!("  plot:       {}", svg.display());
+    match failure {
+        Some(e) => {
+            println!("  stopped early: {e}");
+            Ok(false)
+        }
+        None => Ok(true),
+    }
+}
+
+/// The model with `--set` applied and the starting state: the file's
+/// `[initial]` with `--set` applied, q on h(q) = 0, q̇ projected onto ker A.
+fn start<M: Surfaces<N>, const N: usize>(
+    args: &SimulateArgs,
+) -> Result<(M, State<N>, Residual), String> {
     let mut model = M::with_params(Default::default());
     let mut q = M::INITIAL_COORDINATES;
     let mut v = M::INITIAL_VELOCITIES;
@@ -147,7 +205,16 @@ fn run<M: Surfaces<N>, const N: usize>(args: &SimulateArgs) -> Result<bool, Stri
             "note: the initial velocity {v:?} is not admissible (A q̇ ≠ 0); using its G-orthogonal projection onto ker A, {projected:?}"
         );
     }
-    let v = projected;
+    let start = State {
+        t: 0.0,
+        q,
+        v: projected,
+    };
+    Ok((model, start, start_residual))
+}
+
+/// The simulator's settings from the command line.
+fn settings(args: &SimulateArgs) -> Settings {
     let integrator = match args.integrator {
         Method::Rk4 => Integrator::Rk4(Rk4 { step: args.step }),
         Method::DormandPrince => Integrator::DormandPrince(DormandPrince {
@@ -156,26 +223,20 @@ fn run<M: Surfaces<N>, const N: usize>(args: &SimulateArgs) -> Result<bool, Stri
             max_step: f64::INFINITY,
         }),
     };
-    let settings = Settings {
+    Settings {
         integrator,
         ..Settings::default()
-    };
-    let start = State { t: 0.0, q, v };
-    let mut sim = Simulator::new(&model, start, settings).map_err(|e| e.to_string())?;
-    let every = args.every.unwrap_or(args.t_end / 2000.0);
-    if !(every > 0.0 && args.t_end > 0.0) {
-        return Err("--t-end and --every must be positive".into());
     }
+}
 
-    let e0 = model.energy(&q, &v);
-    let mut rows = vec![Row {
-        t: 0.0,
-        q,
-        v,
-        energy: e0,
-        residual: [start_residual.velocity, start_residual.position],
-        event: None,
-    }];
+/// Runs to `t_end`, a row every `every` and at each collision, with a
+/// progress bar; the error that stopped it early, if any.
+fn integrate<M: Surfaces<N>, const N: usize>(
+    sim: &mut Simulator<'_, M, N>,
+    t_end: f64,
+    every: f64,
+    rows: &mut Vec<Row<N>>,
+) -> Result<Option<String>, String> {
     let bar = ProgressBar::new(1000);
     bar.set_style(
         ProgressStyle::with_template(
@@ -185,13 +246,12 @@ fn run<M: Surfaces<N>, const N: usize>(args: &SimulateArgs) -> Result<bool, Stri
         .progress_chars("=> "),
     );
     bar.set_message(format!("simulating {}", M::NAME));
-    let clock = Instant::now();
     let mut next = every;
     let mut failure = None;
-    while sim.state().t < args.t_end {
-        let target = next.min(args.t_end);
+    while sim.state().t < t_end {
+        let target = next.min(t_end);
         match sim.step(target) {
-            Ok(step) => record::<M, N>(&mut rows, &step),
+            Ok(step) => record::<M, N>(rows, &step),
             Err(e) => {
                 failure = Some(e.to_string());
                 break;
@@ -199,20 +259,21 @@ fn run<M: Surfaces<N>, const N: usize>(args: &SimulateArgs) -> Result<bool, Stri
         }
         if sim.state().t >= target {
             next += every;
-            bar.set_position((1000.0 * sim.state().t / args.t_end) as u64);
+            bar.set_position((1000.0 * sim.state().t / t_end) as u64);
         }
     }
-    let elapsed = clock.elapsed();
     bar.finish_and_clear();
+    Ok(failure)
+}
 
-    std::fs::create_dir_all(&args.out)
-        .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
-    let csv = args.out.join(format!("{}.csv", M::NAME));
-    let svg = args.out.join(format!("{}.svg", M::NAME));
-    write_csv::<M, N>(&csv, &rows)?;
-    let path = path_axes::<M, N>(args.path.as_deref())?;
-    plot::<M, N>(&svg, &rows, path, e0)?;
-
+/// Steps, collisions, evaluations, time, energy drift and residuals.
+fn summary<M: Surfaces<N>, const N: usize>(
+    sim: &Simulator<'_, M, N>,
+    args: &SimulateArgs,
+    rows: &[Row<N>],
+    e0: f64,
+    secs: f64,
+) {
     let stats = sim.stats();
     let drift = rows
         .iter()
@@ -220,7 +281,6 @@ fn run<M: Surfaces<N>, const N: usize>(args: &SimulateArgs) -> Result<bool, Stri
     let worst = rows.iter().fold([0.0f64; 2], |m, r| {
         [m[0].max(r.residual[0]), m[1].max(r.residual[1])]
     });
-    let secs = elapsed.as_secs_f64();
     println!(
         "{}: t = 0 → {} with {:?}",
         M::NAME,
@@ -245,15 +305,6 @@ fn run<M: Surfaces<N>, const N: usize>(args: &SimulateArgs) -> Result<bool, Stri
         "  largest constraint residuals: |A q̇| = {:.2e}, |h(q)| = {:.2e}",
         worst[0], worst[1]
     );
-    println!("  trajectory: {}", csv.display());
-    println!("  plot:       {}", svg.display());
-    match failure {
-        Some(e) => {
-            println!("  stopped early: {e}");
-            Ok(false)
-        }
-        None => Ok(true),
-    }
 }
 
 fn record<M: Surfaces<N>, const N: usize>(rows: &mut Vec<Row<N>>, step: &Step<M::Wall, N>) {
@@ -327,108 +378,4 @@ fn path_axes<M: Surfaces<N>, const N: usize>(spec: Option<&str>) -> Result<(usiz
             Ok((find(a)?, find(b)?))
         }
     }
-}
-
-fn range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
-    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
-        (l.min(x), h.max(x))
-    });
-    if !lo.is_finite() || !hi.is_finite() {
-        return 0.0..1.0;
-    }
-    let pad = ((hi - lo) * 0.05).max(1e-12 * (1.0 + lo.abs().max(hi.abs())));
-    lo - pad..hi + pad
-}
-
-/// Three panels: the coordinates over time, the path, and the energy drift.
-fn plot<M: Surfaces<N>, const N: usize>(
-    file: &Path,
-    rows: &[Row<N>],
-    (a, b): (usize, usize),
-    e0: f64,
-) -> Result<(), String> {
-    let err = |e: &dyn std::fmt::Display| format!("plotting {}: {e}", file.display());
-    let root = SVGBackend::new(file, (1000, 1200)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    let panels = root.split_evenly((3, 1));
-    let t_range = 0.0..rows.last().map_or(1.0, |r| r.t.max(1e-12));
-
-    let mut chart = ChartBuilder::on(&panels[0])
-        .caption(format!("{}: coordinates", M::NAME), ("sans-serif", 22))
-        .margin(12)
-        .x_label_area_size(36)
-        .y_label_area_size(60)
-        .build_cartesian_2d(t_range.clone(), range(rows.iter().flat_map(|r| r.q)))
-        .map_err(|e| err(&e))?;
-    chart
-        .configure_mesh()
-        .x_desc("t")
-        .draw()
-        .map_err(|e| err(&e))?;
-    for i in 0..N {
-        let color = Palette99::pick(i).to_rgba();
-        chart
-            .draw_series(LineSeries::new(rows.iter().map(|r| (r.t, r.q[i])), color))
-            .map_err(|e| err(&e))?
-            .label(M::COORDINATES[i])
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
-    }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| err(&e))?;
-
-    let mut path = ChartBuilder::on(&panels[1])
-        .caption(
-            format!("path: {} against {}", M::COORDINATES[b], M::COORDINATES[a]),
-            ("sans-serif", 22),
-        )
-        .margin(12)
-        .x_label_area_size(36)
-        .y_label_area_size(60)
-        .build_cartesian_2d(
-            range(rows.iter().map(|r| r.q[a])),
-            range(rows.iter().map(|r| r.q[b])),
-        )
-        .map_err(|e| err(&e))?;
-    path.configure_mesh()
-        .x_desc(M::COORDINATES[a])
-        .y_desc(M::COORDINATES[b])
-        .draw()
-        .map_err(|e| err(&e))?;
-    path.draw_series(LineSeries::new(rows.iter().map(|r| (r.q[a], r.q[b])), BLUE))
-        .map_err(|e| err(&e))?;
-    path.draw_series(
-        rows.iter()
-            .filter(|r| r.event.is_some())
-            .map(|r| Circle::new((r.q[a], r.q[b]), 3, RED.filled())),
-    )
-    .map_err(|e| err(&e))?;
-
-    let mut energy = ChartBuilder::on(&panels[2])
-        .caption(
-            format!("energy drift E − E₀ (E₀ = {e0:.6})"),
-            ("sans-serif", 22),
-        )
-        .margin(12)
-        .x_label_area_size(36)
-        .y_label_area_size(80)
-        .build_cartesian_2d(t_range, range(rows.iter().map(|r| r.energy - e0)))
-        .map_err(|e| err(&e))?;
-    energy
-        .configure_mesh()
-        .x_desc("t")
-        .y_label_formatter(&|y| format!("{y:.1e}"))
-        .draw()
-        .map_err(|e| err(&e))?;
-    energy
-        .draw_series(LineSeries::new(
-            rows.iter().map(|r| (r.t, r.energy - e0)),
-            RED,
-        ))
-        .map_err(|e| err(&e))?;
-    root.present().map_err(|e| err(&e))?;
-    Ok(())
 }

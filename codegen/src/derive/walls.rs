@@ -50,43 +50,12 @@ fn wall(
     w: &Wall,
     raw: &RawWall,
 ) -> Result<Option<WallDerivation>, Reported> {
-    let (sym, low, exact) = (c.sym, c.low, c.exact);
-    let n = sym.vels.len();
+    let (sym, low) = (c.sym, c.low);
     let span = Some(w.span.clone());
-    let normal_r: Vec<Rat> = raw.normal.iter().map(|a| low.to_rat(a)).collect();
-    let mut candidates = vec![(normal_r, "the normal velocity".to_string())];
-    for (r, label) in exact.a.iter().zip(&c.raw.a_labels) {
-        candidates.push((r.clone(), label.clone()));
-    }
-    for (k, row) in raw.contact.iter().enumerate() {
-        let r = row.iter().map(|a| low.to_rat(a)).collect();
-        candidates.push((r, format!("contact constraint {}", k + 1)));
-    }
-    let (kept, dropped) = independent_rows(&candidates, n, &exact.field);
-    let b: Vec<Vec<Rat>> = kept.iter().map(|(r, _)| r.clone()).collect();
-    checks::wall_hypotheses(cx, w, &b, &exact.a, &candidates[0].0, &exact.field);
-    if kept.is_empty() {
+    let Some(b) = rows(c, cx, w, raw)? else {
         return Ok(None);
-    }
-    let b_mat = rows_matrix(&b, n, &exact.field).ok_or_else(|| {
-        cx.error(
-            ErrorKind::Symbolic(format!("wall `{}`: B as a matrix", w.name)),
-            span.clone(),
-        )
-    })?;
-    let b_atoms: Vec<Vec<Atom>> = b
-        .iter()
-        .map(|r| r.iter().map(|x| low.raise(&x.to_expression())).collect())
-        .collect();
-    if sym.model.kind == Kind::Coordinates {
-        let rows = WallRows {
-            surface: &raw.surface,
-            normal: &raw.normal,
-            a: &c.raw.a_rows,
-            b: &b_atoms,
-        };
-        checks::on_wall(sym, cx, w, &rows);
-    }
+    };
+    let (b_mat, b_atoms, kept, dropped) = (b.matrix, b.atoms, b.origin, b.dropped);
     let closed = match c.g_inv {
         Some(g_inv) => Some(closed_form(sym, low, g_inv, &b_mat).ok_or_else(|| {
             cx.error(
@@ -141,10 +110,73 @@ fn wall(
         doc: w.doc.clone(),
         geometry,
         b_rows: strings(&b_atoms),
-        b_origin: kept.into_iter().map(|(_, o)| o).collect(),
+        b_origin: kept,
         dropped,
         projection,
         functions,
+    }))
+}
+
+/// A wall's B: its independent rows and where they came from.
+struct WallB {
+    matrix: Matrix<Field>,
+    /// The rows as expressions, functions raised.
+    atoms: Vec<Vec<Atom>>,
+    origin: Vec<String>,
+    dropped: Vec<String>,
+}
+
+/// B's candidate rows (the normal velocity, A's rows, the contact rows)
+/// with the dependent ones removed, the hypotheses (1.3) checked for
+/// generic q and at a point of the wall; `None` when no row is left (a
+/// hypothesis check has then failed).
+fn rows(
+    c: &Context,
+    cx: &mut Collector,
+    w: &Wall,
+    raw: &RawWall,
+) -> Result<Option<WallB>, Reported> {
+    let (sym, low, exact) = (c.sym, c.low, c.exact);
+    let n = sym.vels.len();
+    let normal_r: Vec<Rat> = raw.normal.iter().map(|a| low.to_rat(a)).collect();
+    let mut candidates = vec![(normal_r, "the normal velocity".to_string())];
+    for (r, label) in exact.a.iter().zip(&c.raw.a_labels) {
+        candidates.push((r.clone(), label.clone()));
+    }
+    for (k, row) in raw.contact.iter().enumerate() {
+        let r = row.iter().map(|a| low.to_rat(a)).collect();
+        candidates.push((r, format!("contact constraint {}", k + 1)));
+    }
+    let (kept, dropped) = independent_rows(&candidates, n, &exact.field);
+    let b: Vec<Vec<Rat>> = kept.iter().map(|(r, _)| r.clone()).collect();
+    checks::wall_hypotheses(cx, w, &b, &exact.a, &candidates[0].0, &exact.field);
+    if kept.is_empty() {
+        return Ok(None);
+    }
+    let matrix = rows_matrix(&b, n, &exact.field).ok_or_else(|| {
+        cx.error(
+            ErrorKind::Symbolic(format!("wall `{}`: B as a matrix", w.name)),
+            Some(w.span.clone()),
+        )
+    })?;
+    let atoms: Vec<Vec<Atom>> = b
+        .iter()
+        .map(|r| r.iter().map(|x| low.raise(&x.to_expression())).collect())
+        .collect();
+    if sym.model.kind == Kind::Coordinates {
+        let rows = WallRows {
+            surface: &raw.surface,
+            normal: &raw.normal,
+            a: &c.raw.a_rows,
+            b: &atoms,
+        };
+        checks::on_wall(sym, cx, w, &rows);
+    }
+    Ok(Some(WallB {
+        matrix,
+        atoms,
+        origin: kept.into_iter().map(|(_, o)| o).collect(),
+        dropped,
     }))
 }
 

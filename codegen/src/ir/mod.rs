@@ -7,6 +7,7 @@
 
 mod file;
 mod lex;
+mod names;
 mod number;
 mod validate;
 

@@ -2,18 +2,15 @@
 //! what is wrong with its file:line:col and going on.
 
 use std::collections::{BTreeMap, HashMap};
-use std::ops::Range;
 use std::path::Path;
 
 use indexmap::IndexMap;
 use toml::Spanned;
 
 use super::file::{File, Names, Number, ParamDecl, WallDecl};
-use super::lex::{Token, content_start, tokens};
+use super::lex::{Token, tokens};
 use super::number::{initial_value, rational};
-use super::{
-    Expr, FUNCTIONS, Kind, Model, Param, ProjectorMode, RESERVED, RUST_KEYWORDS, Rational, Wall,
-};
+use super::{Expr, Kind, Model, Param, ProjectorMode, Rational, Wall};
 use crate::diag::{Collector, ErrorKind};
 
 pub(super) struct Validator<'a> {
@@ -38,24 +35,7 @@ impl Validator<'_> {
             );
         }
 
-        let projector = match header
-            .projector
-            .as_ref()
-            .map(|p| (p.get_ref().as_str(), p.span()))
-        {
-            None | Some(("auto", _)) => ProjectorMode::Auto,
-            Some(("symbolic", _)) => ProjectorMode::Symbolic,
-            Some(("structured", _)) => ProjectorMode::Structured,
-            Some((other, span)) => {
-                self.cx.error(
-                    ErrorKind::Structure(format!(
-                        "[model] projector = `{other}`: write \"auto\", \"symbolic\" or \"structured\""
-                    )),
-                    Some(span),
-                );
-                ProjectorMode::Auto
-            }
-        };
+        let projector = self.projector_mode(header.projector.as_ref());
         let params = self.params(&file.parameters);
         let (kind, coordinates, velocities) =
             self.variables(file.coordinates.as_ref(), file.velocities.as_ref());
@@ -149,79 +129,8 @@ impl Validator<'_> {
         vels: Option<&Spanned<Names>>,
     ) -> (Kind, Vec<String>, Vec<String>) {
         match (coords, vels) {
-            (Some(c), None) => {
-                let names = c.get_ref();
-                let q: Vec<String> = names
-                    .names
-                    .iter()
-                    .map(|n| {
-                        self.declare(n, "coordinate");
-                        n.get_ref().clone()
-                    })
-                    .collect();
-                let v = match &names.velocities {
-                    Some(vs) => {
-                        if vs.len() != q.len() {
-                            self.cx.error(
-                                ErrorKind::Structure(format!(
-                                    "{} coordinates but {} velocity names",
-                                    q.len(),
-                                    vs.len()
-                                )),
-                                Some(c.span()),
-                            );
-                        }
-                        vs.iter()
-                            .map(|n| {
-                                self.declare(n, "velocity");
-                                n.get_ref().clone()
-                            })
-                            .collect()
-                    }
-                    None => q
-                        .iter()
-                        .zip(&names.names)
-                        .map(|(n, s)| {
-                            let v = format!("{n}_dot");
-                            self.declare(&Spanned::new(s.span(), v.clone()), "velocity");
-                            v
-                        })
-                        .collect(),
-                };
-                if q.is_empty() {
-                    self.cx.error(
-                        ErrorKind::Structure("`coordinates.names` is empty".into()),
-                        Some(c.span()),
-                    );
-                }
-                (Kind::Coordinates, q, v)
-            }
-            (None, Some(v)) => {
-                if v.get_ref().velocities.is_some() {
-                    self.cx.error(
-                        ErrorKind::Structure(
-                            "`velocities` takes only `names`; `velocities.velocities` is for coordinates".into(),
-                        ),
-                        Some(v.span()),
-                    );
-                }
-                let names: Vec<String> = v
-                    .get_ref()
-                    .names
-                    .iter()
-                    .map(|n| {
-                        self.declare(n, "velocity");
-                        n.get_ref().clone()
-                    })
-                    .collect();
-                if names.is_empty() {
-                    self.cx.error(
-                        ErrorKind::Structure("`velocities.names` is empty".into()),
-                        Some(v.span()),
-                    );
-                }
-                (Kind::Instantaneous, Vec::new(), names)
-            }
+            (Some(c), None) => self.coordinates(c),
+            (None, Some(v)) => self.instantaneous(v),
             (Some(c), Some(_)) => {
                 self.cx.error(
                     ErrorKind::Structure(
@@ -241,6 +150,103 @@ impl Validator<'_> {
                 (Kind::Instantaneous, Vec::new(), Vec::new())
             }
         }
+    }
+
+    /// `[model] projector`: auto (the default), symbolic or structured.
+    fn projector_mode(&mut self, mode: Option<&Spanned<String>>) -> ProjectorMode {
+        match mode.map(|p| (p.get_ref().as_str(), p.span())) {
+            None | Some(("auto", _)) => ProjectorMode::Auto,
+            Some(("symbolic", _)) => ProjectorMode::Symbolic,
+            Some(("structured", _)) => ProjectorMode::Structured,
+            Some((other, span)) => {
+                self.cx.error(
+                    ErrorKind::Structure(format!(
+                        "[model] projector = `{other}`: write \"auto\", \"symbolic\" or \"structured\""
+                    )),
+                    Some(span),
+                );
+                ProjectorMode::Auto
+            }
+        }
+    }
+
+    /// `[coordinates]`: the names and their velocities (`<name>_dot` unless
+    /// given).
+    fn coordinates(&mut self, c: &Spanned<Names>) -> (Kind, Vec<String>, Vec<String>) {
+        let names = c.get_ref();
+        let q: Vec<String> = names
+            .names
+            .iter()
+            .map(|n| {
+                self.declare(n, "coordinate");
+                n.get_ref().clone()
+            })
+            .collect();
+        let v = match &names.velocities {
+            Some(vs) => {
+                if vs.len() != q.len() {
+                    self.cx.error(
+                        ErrorKind::Structure(format!(
+                            "{} coordinates but {} velocity names",
+                            q.len(),
+                            vs.len()
+                        )),
+                        Some(c.span()),
+                    );
+                }
+                vs.iter()
+                    .map(|n| {
+                        self.declare(n, "velocity");
+                        n.get_ref().clone()
+                    })
+                    .collect()
+            }
+            None => q
+                .iter()
+                .zip(&names.names)
+                .map(|(n, s)| {
+                    let v = format!("{n}_dot");
+                    self.declare(&Spanned::new(s.span(), v.clone()), "velocity");
+                    v
+                })
+                .collect(),
+        };
+        if q.is_empty() {
+            self.cx.error(
+                ErrorKind::Structure("`coordinates.names` is empty".into()),
+                Some(c.span()),
+            );
+        }
+        (Kind::Coordinates, q, v)
+    }
+
+    /// `[velocities]` of an instantaneous model.
+    fn instantaneous(&mut self, v: &Spanned<Names>) -> (Kind, Vec<String>, Vec<String>) {
+        if v.get_ref().velocities.is_some() {
+            self.cx.error(
+                ErrorKind::Structure(
+                    "`velocities` takes only `names`; `velocities.velocities` is for coordinates"
+                        .into(),
+                ),
+                Some(v.span()),
+            );
+        }
+        let names: Vec<String> = v
+            .get_ref()
+            .names
+            .iter()
+            .map(|n| {
+                self.declare(n, "velocity");
+                n.get_ref().clone()
+            })
+            .collect();
+        if names.is_empty() {
+            self.cx.error(
+                ErrorKind::Structure("`velocities.names` is empty".into()),
+                Some(v.span()),
+            );
+        }
+        (Kind::Instantaneous, Vec::new(), names)
     }
 
     /// Definitions, each rewritten free of other definitions.
@@ -390,111 +396,5 @@ impl Validator<'_> {
             }
         }
         out
-    }
-
-    fn declare(&mut self, name: &Spanned<String>, what: &'static str) {
-        let n = name.get_ref();
-        self.check_ident(n, name.span(), true);
-        if let Some(first) = self.names.get(n.as_str()) {
-            self.cx.error(
-                ErrorKind::Duplicate {
-                    name: n.clone(),
-                    first,
-                },
-                Some(name.span()),
-            );
-        } else {
-            self.names.insert(n.clone(), what);
-        }
-    }
-
-    fn check_ident(&mut self, name: &str, span: Range<usize>, symbol: bool) {
-        let why = if name.is_empty() {
-            Some("it is empty".to_string())
-        } else if !name.starts_with(|c: char| c.is_ascii_alphabetic()) {
-            Some("a name starts with a letter".into())
-        } else if !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
-            Some("a name has only ASCII letters, digits and `_`".into())
-        } else if name.ends_with('_') {
-            Some("a name may not end with `_`".into())
-        } else if name.contains("__") {
-            Some("a name may not contain `__`".into())
-        } else if RUST_KEYWORDS.contains(&name) {
-            Some("it is a Rust keyword".into())
-        } else if symbol && RESERVED.contains(&name) {
-            Some("it is reserved (a function, a constant or a name the generated code uses)".into())
-        } else {
-            None
-        };
-        if let Some(why) = why {
-            self.cx.error(
-                ErrorKind::BadName {
-                    name: name.to_string(),
-                    why,
-                },
-                Some(span),
-            );
-        }
-    }
-
-    /// Checks an expression's tokens; unknown names are checked later, once
-    /// every declaration is known ([`check_names`]).
-    fn expr(&mut self, s: &Spanned<String>) -> Expr {
-        let expr = Expr {
-            text: s.get_ref().clone(),
-            span: s.span(),
-        };
-        let base = content_start(self.text, &expr);
-        let mut depth: i64 = 0;
-        let mut empty = true;
-        for tok in tokens(&expr.text) {
-            empty = false;
-            let at = |r: &Range<usize>| base.map(|b| b + r.start..b + r.end).or(Some(s.span()));
-            match tok {
-                Token::Bad(c, r) => {
-                    self.cx.error(
-                        ErrorKind::Syntax(format!("unexpected character `{c}`")),
-                        at(&r),
-                    );
-                }
-                Token::Decimal(t, r) => {
-                    self.cx.error(
-                        ErrorKind::Syntax(format!(
-                            "`{t}` is a decimal number; models are exact: write it as a fraction"
-                        )),
-                        at(&r),
-                    );
-                }
-                Token::Open => depth += 1,
-                Token::Close(r) => {
-                    depth -= 1;
-                    if depth < 0 {
-                        self.cx
-                            .error(ErrorKind::Syntax("unmatched `)`".into()), at(&r));
-                        depth = 0;
-                    }
-                }
-                Token::Call(n, r) if !FUNCTIONS.contains(&n) => {
-                    self.cx.error(
-                        ErrorKind::UnknownFunction {
-                            name: n.to_string(),
-                        },
-                        at(&r),
-                    );
-                }
-                _ => {}
-            }
-        }
-        if empty {
-            self.cx.error(
-                ErrorKind::Syntax("the expression is empty".into()),
-                Some(s.span()),
-            );
-        }
-        if depth > 0 {
-            self.cx
-                .error(ErrorKind::Syntax("unclosed `(`".into()), Some(s.span()));
-        }
-        expr
     }
 }

@@ -8,16 +8,48 @@ use super::{Collision, Located, SimError, Simulator, State};
 use crate::Surfaces;
 
 impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
-    /// Resolves the collision located on the step from (t0, y0): Newton's
-    /// method on f from where it was located, along real steps or, for tiny
-    /// corrections, Taylor steps, staying in [t0, t_hi]; then the collision
-    /// map.
+    /// Resolves the collision located on the step from (t0, y0): polished
+    /// to the wall, checked, mapped by v⁺ = (I − 2P)v⁻; the simulator goes
+    /// on from there.
     pub(super) fn collide(
         &mut self,
         y0: &Phase<N>,
         t0: f64,
         located: Located<N>,
     ) -> Result<Collision<M::Wall, N>, SimError<M::Wall>> {
+        let k = located.wall;
+        let (tc, y) = self.polish(y0, t0, located)?;
+        let collision = self.resolve(k, tc, &y)?;
+        self.state = State {
+            t: tc,
+            q: y.q,
+            v: collision.v_plus,
+        };
+        self.departing |= 1 << k;
+        // Go on with steps of at most twice the time since the previous
+        // collision: an error-free stretch (a parabola) would otherwise let
+        // the proposal grow without bound, and a step far longer than the
+        // motion between collisions locates the next crossing less well;
+        // twice that time usually reaches the next collision in one step.
+        let since = tc - self.last_collision.unwrap_or(t0);
+        if since > 0.0 {
+            self.proposal = self.proposal.min(2.0 * since);
+        }
+        self.last_collision = Some(tc);
+        self.project()?;
+        self.f0 = self.rhs(tc, &self.phase())?;
+        Ok(collision)
+    }
+
+    /// Newton's method on f from where the collision was located, along
+    /// real steps from (t0, y0) or, for tiny corrections, Taylor steps,
+    /// staying in [t0, t_hi]: the instant and the state at the wall.
+    fn polish(
+        &mut self,
+        y0: &Phase<N>,
+        t0: f64,
+        located: Located<N>,
+    ) -> Result<(f64, Phase<N>), SimError<M::Wall>> {
         let m = self.model;
         let Located {
             wall: k,
@@ -61,6 +93,20 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             y = candidate;
             fy = f_candidate;
         }
+        Ok((tc, y))
+    }
+
+    /// The collision with wall `k` at (tc, y): refused when grazing, when
+    /// the map does not reverse the normal velocity (B loses rank there) or
+    /// when another wall is met at the same time.
+    fn resolve(
+        &self,
+        k: usize,
+        tc: f64,
+        y: &Phase<N>,
+    ) -> Result<Collision<M::Wall, N>, SimError<M::Wall>> {
+        let m = self.model;
+        let wall = M::WALLS[k];
         let normal = norm(&m.normal(wall, &y.q));
         let nv = m.normal_velocity(wall, &y.q, &y.v);
         if -nv <= self.settings.grazing * normal * norm(&y.v) {
@@ -87,38 +133,13 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
                 });
             }
         }
-        let collision = Collision {
+        Ok(Collision {
             wall,
             t: tc,
             q: y.q,
             v_minus: y.v,
             v_plus,
             surface: m.surface(wall, &y.q),
-        };
-        self.state = State {
-            t: tc,
-            q: y.q,
-            v: v_plus,
-        };
-        self.departing |= 1 << k;
-        // Go on with steps of at most twice the time since the previous
-        // collision: an error-free stretch (a parabola) would otherwise let
-        // the proposal grow without bound, and a step far longer than the
-        // motion between collisions locates the next crossing less well;
-        // twice that time usually reaches the next collision in one step.
-        let since = tc - self.last_collision.unwrap_or(t0);
-        if since > 0.0 {
-            self.h = self.h.min(2.0 * since);
-        }
-        self.last_collision = Some(tc);
-        self.project()?;
-        self.f0 = self.rhs(
-            tc,
-            &Phase {
-                q: self.state.q,
-                v: self.state.v,
-            },
-        )?;
-        Ok(collision)
+        })
     }
 }

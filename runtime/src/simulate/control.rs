@@ -18,15 +18,15 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         h: f64,
     ) -> Result<(Phase<N>, Option<Phase<N>>), SimError<M::Wall>> {
         let (model, stats, f0) = (self.model, &mut self.stats, self.f0);
-        let mut f = |t: f64, y: &Phase<N>| derivative(model, stats, t, y);
-        self.settings.integrator.advance(&mut f, y0, &f0, t0, h)
+        let mut rhs = |t: f64, y: &Phase<N>| derivative(model, stats, t, y);
+        self.settings.integrator.advance(&mut rhs, y0, &f0, t0, h)
     }
 
     /// One step of length `h` from (t0, y0) without error control.
     fn trial(&mut self, y0: &Phase<N>, t0: f64, h: f64) -> Result<Trial<N>, SimError<M::Wall>> {
         let (model, stats, f0) = (self.model, &mut self.stats, self.f0);
-        let mut f = |t: f64, y: &Phase<N>| derivative(model, stats, t, y);
-        self.settings.integrator.trial(&mut f, y0, &f0, t0, h)
+        let mut rhs = |t: f64, y: &Phase<N>| derivative(model, stats, t, y);
+        self.settings.integrator.trial(&mut rhs, y0, &f0, t0, h)
     }
 
     /// Trial steps of at most `limit` until one is accepted; returns its
@@ -42,7 +42,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         let mut rejected = false;
         let mut failures = 0;
         loop {
-            let h = self.h.min(t_end - t0).min(limit);
+            let h = self.proposal.min(t_end - t0).min(limit);
             if h <= SMALLEST_STEP_ULPS * f64::EPSILON * t0.abs().max(1.0) && t0 + h < t_end {
                 return Err(SimError::StepTooSmall { t: t0, step: h });
             }
@@ -56,7 +56,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
                 Ok(trial) => trial,
                 Err(SimError::Dynamics { .. }) if failures < FAILED_STEP_RETRIES => {
                     failures += 1;
-                    self.h = FAILED_STEP_SHRINK * h;
+                    self.proposal = FAILED_STEP_SHRINK * h;
                     rejected = true;
                     self.stats.rejected += 1;
                     continue;
@@ -70,11 +70,15 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
                 // A step cut short by t_end or by an aim says nothing
                 // against the longer proposal: keep it if it is longer.
                 let grown = h * fac;
-                let proposal = if h < self.h { self.h.max(grown) } else { grown };
-                self.h = proposal.min(method.max_step());
+                let proposal = if h < self.proposal {
+                    self.proposal.max(grown)
+                } else {
+                    grown
+                };
+                self.proposal = proposal.min(method.max_step());
                 return Ok((h, trial));
             }
-            self.h = h * fac.min(1.0);
+            self.proposal = h * fac.min(1.0);
             rejected = true;
             self.stats.rejected += 1;
         }

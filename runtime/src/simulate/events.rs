@@ -118,82 +118,113 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         t0: f64,
         h: f64,
     ) -> Result<Option<f64>, SimError<M::Wall>> {
-        let m = self.model;
-        let wall = M::WALLS[k];
-        let state = |theta: f64| -> Phase<N> {
-            if theta == 0.0 {
-                *y0
-            } else if theta == 1.0 {
-                trial.y1
-            } else {
-                trial.dense.at(theta, h)
-            }
+        let on = OnStep {
+            model: self.model,
+            wall: M::WALLS[k],
+            y0,
+            trial,
+            h,
         };
-        let f = |theta: f64| {
-            let q = if theta == 0.0 {
-                y0.q
-            } else if theta == 1.0 {
-                trial.y1.q
-            } else {
-                trial.dense.position(theta, h)
-            };
-            m.surface(wall, &q)
-        };
-        let rate = |theta: f64| {
-            let y = state(theta);
-            m.normal_velocity(wall, &y.q, &y.v)
-        };
-        // One dense-output evaluation per sample for both f and its rate.
-        let sample = |theta: f64| {
-            let y = state(theta);
-            (
-                theta,
-                m.surface(wall, &y.q),
-                m.normal_velocity(wall, &y.q, &y.v),
-            )
-        };
+        let (f, rate) = (|theta| on.f(theta), |theta| on.rate(theta));
         let n = self.settings.samples + 1;
-        let mut prev = sample(0.0);
-        let mut leaving = self.departing & (1 << k) != 0 && prev.1 <= 0.0 && prev.2 > 0.0;
-        if !leaving && prev.1 <= 0.0 {
+        let mut prev = on.sample(0.0);
+        let mut leaving = self.departing & (1 << k) != 0 && prev.f <= 0.0 && prev.rate > 0.0;
+        if !leaving && prev.f <= 0.0 {
             // At or beyond the wall at the step's start and not leaving it
             // (a projection can move q by rounding-sized amounts).
             return Ok(Some(0.0));
         }
         for j in 1..=n {
-            let now = sample(j as f64 / n as f64);
+            let now = on.sample(j as f64 / n as f64);
             if leaving {
-                if now.1 > 0.0 {
+                if now.f > 0.0 {
                     leaving = false;
-                } else if now.2 <= 0.0 {
+                } else if now.rate <= 0.0 {
                     // Turned back before a sample saw it off the wall: find
                     // the top of the excursion.
-                    let top = illinois(&rate, (prev.0, prev.2), (now.0, now.2));
+                    let top = illinois(&rate, (prev.theta, prev.rate), (now.theta, now.rate));
                     let f_top = f(top);
                     if f_top > 0.0 {
-                        return Ok(Some(illinois(&f, (top, f_top), (now.0, now.1))));
+                        return Ok(Some(illinois(&f, (top, f_top), (now.theta, now.f))));
                     }
                     return Err(SimError::Grazing {
-                        wall,
+                        wall: on.wall,
                         t: t0 + top * h,
                         normal_velocity: rate(top),
                     });
                 }
-            } else if now.1 <= 0.0 {
-                return Ok(Some(illinois(&f, (prev.0, prev.1), (now.0, now.1))));
-            } else if prev.2 < 0.0 && now.2 > 0.0 {
+            } else if now.f <= 0.0 {
+                return Ok(Some(illinois(&f, (prev.theta, prev.f), (now.theta, now.f))));
+            } else if prev.rate < 0.0 && now.rate > 0.0 {
                 // f stays positive at both samples but turns: check the
                 // bottom of the dip.
                 let falling = |theta: f64| -rate(theta);
-                let bottom = illinois(&falling, (prev.0, -prev.2), (now.0, -now.2));
+                let bottom = illinois(&falling, (prev.theta, -prev.rate), (now.theta, -now.rate));
                 let f_bottom = f(bottom);
                 if f_bottom <= 0.0 {
-                    return Ok(Some(illinois(&f, (prev.0, prev.1), (bottom, f_bottom))));
+                    return Ok(Some(illinois(&f, (prev.theta, prev.f), (bottom, f_bottom))));
                 }
             }
             prev = now;
         }
         Ok(None)
+    }
+}
+
+/// One wall seen along one step: f and its rate at any θ ∈ [0, 1], from the
+/// step's ends or its dense output.
+struct OnStep<'a, M: Surfaces<N>, const N: usize> {
+    model: &'a M,
+    wall: M::Wall,
+    y0: &'a Phase<N>,
+    trial: &'a Trial<N>,
+    h: f64,
+}
+
+/// f and its rate at one θ of a step.
+#[derive(Clone, Copy)]
+struct Sample {
+    theta: f64,
+    f: f64,
+    rate: f64,
+}
+
+impl<M: Surfaces<N>, const N: usize> OnStep<'_, M, N> {
+    fn state(&self, theta: f64) -> Phase<N> {
+        if theta == 0.0 {
+            *self.y0
+        } else if theta == 1.0 {
+            self.trial.y1
+        } else {
+            self.trial.dense.at(theta, self.h)
+        }
+    }
+
+    /// f alone (its coordinates are half the dense output's work).
+    fn f(&self, theta: f64) -> f64 {
+        let q = if theta == 0.0 {
+            self.y0.q
+        } else if theta == 1.0 {
+            self.trial.y1.q
+        } else {
+            self.trial.dense.position(theta, self.h)
+        };
+        self.model.surface(self.wall, &q)
+    }
+
+    fn rate(&self, theta: f64) -> f64 {
+        let y = self.state(theta);
+        self.model.normal_velocity(self.wall, &y.q, &y.v)
+    }
+
+    /// f and its rate from one dense-output evaluation.
+    fn sample(&self, theta: f64) -> Sample {
+        let y = self.state(theta);
+        Sample {
+            theta,
+            f: self.model.surface(self.wall, &y.q),
+            rate: self.model.normal_velocity(self.wall, &y.q, &y.v),
+        }
     }
 }
 

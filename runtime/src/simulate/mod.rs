@@ -68,8 +68,8 @@ pub struct Simulator<'m, M: Surfaces<N>, const N: usize> {
     state: State<N>,
     /// (q̇, q̈) at `state`.
     f0: Phase<N>,
-    /// The next trial step.
-    h: f64,
+    /// The length proposed for the next trial step.
+    proposal: f64,
     /// Walls (bit per index into `M::WALLS`) just collided with and not yet
     /// left: their f starts at ≈ 0 and must become positive first.
     departing: u64,
@@ -157,7 +157,7 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
             settings,
             state: start,
             f0,
-            h: settings.integrator.initial_step(&y, &f0),
+            proposal: settings.integrator.initial_step(&y, &f0),
             departing,
             last_collision: None,
             stats,

@@ -18,10 +18,10 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         let t = self.state.t;
         let fail = |error| SimError::Projection { t, error };
         let mut moved = false;
-        let h = m.holonomic(&self.state.q);
-        if !h.as_slice().is_empty() {
+        let holonomic = m.holonomic(&self.state.q);
+        if !holonomic.as_slice().is_empty() {
             let mut q = self.state.q;
-            let mut r = h;
+            let mut r = holonomic;
             let mut done = false;
             for _ in 0..HOLONOMIC_STEPS {
                 if r.max_abs() <= HOLONOMIC_DONE_ULPS * f64::EPSILON * (1.0 + norm(&q)) {

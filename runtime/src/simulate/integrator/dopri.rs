@@ -89,7 +89,7 @@ const SHRINK_MOST_ABOVE: f64 = 1845.28125;
 impl DormandPrince {
     /// The seven stages of one step (the last is f(y₁), FSAL) and y₁.
     fn stages<const N: usize, E>(
-        f: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
+        rhs: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
         y0: &Phase<N>,
         f0: &Phase<N>,
         t0: f64,
@@ -100,7 +100,7 @@ impl DormandPrince {
         for s in 1..7 {
             let terms: [(f64, &Phase<N>); 6] = core::array::from_fn(|j| (A[s][j], &k[j]));
             let ys = y0.plus(h, &terms[..s]);
-            k[s] = f(t0 + C[s] * h, &ys)?;
+            k[s] = rhs(t0 + C[s] * h, &ys)?;
         }
         // The last stage was evaluated at y₁ itself.
         let terms: [(f64, &Phase<N>); 6] = core::array::from_fn(|j| (A[6][j], &k[j]));
@@ -146,27 +146,27 @@ impl Method for DormandPrince {
 
     fn advance<const N: usize, Er>(
         &self,
-        f: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, Er>,
+        rhs: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, Er>,
         y0: &Phase<N>,
         f0: &Phase<N>,
         t0: f64,
         h: f64,
     ) -> Result<(Phase<N>, Option<Phase<N>>), Er> {
         let mut k = [Phase::ZERO; 7];
-        let y1 = Self::stages(f, y0, f0, t0, h, &mut k)?;
+        let y1 = Self::stages(rhs, y0, f0, t0, h, &mut k)?;
         Ok((y1, Some(k[6])))
     }
 
     fn trial<const N: usize, Er>(
         &self,
-        f: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, Er>,
+        rhs: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, Er>,
         y0: &Phase<N>,
         f0: &Phase<N>,
         t0: f64,
         h: f64,
     ) -> Result<Trial<N>, Er> {
         let mut k = [Phase::ZERO; 7];
-        let y1 = Self::stages(f, y0, f0, t0, h, &mut k)?;
+        let y1 = Self::stages(rhs, y0, f0, t0, h, &mut k)?;
         let e_terms: [(f64, &Phase<N>); 7] = core::array::from_fn(|j| (E[j], &k[j]));
         let err = Phase::ZERO.plus(h, &e_terms);
         let error = scaled_norm(&err, y0, &y1, self.rtol, self.atol);

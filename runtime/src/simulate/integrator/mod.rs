@@ -33,7 +33,7 @@ pub(crate) struct Trial<const N: usize> {
     pub dense: Dense<N>,
 }
 
-/// What the simulator needs of a method. `f` evaluates (q̇, q̈) at a time
+/// What the simulator needs of a method. `rhs` evaluates (q̇, q̈) at a time
 /// and state; its error type is the simulator's.
 pub(crate) trait Method {
     /// Whether the settings are usable (positive, finite steps and
@@ -59,7 +59,7 @@ pub(crate) trait Method {
     /// output.
     fn advance<const N: usize, E>(
         &self,
-        f: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
+        rhs: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
         y0: &Phase<N>,
         f0: &Phase<N>,
         t0: f64,
@@ -70,7 +70,7 @@ pub(crate) trait Method {
     /// dense output, and without error control.
     fn trial<const N: usize, E>(
         &self,
-        f: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
+        rhs: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
         y0: &Phase<N>,
         f0: &Phase<N>,
         t0: f64,
@@ -107,22 +107,22 @@ impl Method for Integrator {
     }
     fn advance<const N: usize, E>(
         &self,
-        f: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
+        rhs: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
         y0: &Phase<N>,
         f0: &Phase<N>,
         t0: f64,
         h: f64,
     ) -> Result<(Phase<N>, Option<Phase<N>>), E> {
-        with_method!(self, m => m.advance(f, y0, f0, t0, h))
+        with_method!(self, m => m.advance(rhs, y0, f0, t0, h))
     }
     fn trial<const N: usize, E>(
         &self,
-        f: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
+        rhs: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
         y0: &Phase<N>,
         f0: &Phase<N>,
         t0: f64,
         h: f64,
     ) -> Result<Trial<N>, E> {
-        with_method!(self, m => m.trial(f, y0, f0, t0, h))
+        with_method!(self, m => m.trial(rhs, y0, f0, t0, h))
     }
 }

@@ -37,7 +37,7 @@ impl Method for Rk4 {
 
     fn advance<const N: usize, E>(
         &self,
-        f: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
+        rhs: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
         y0: &Phase<N>,
         f0: &Phase<N>,
         t0: f64,
@@ -45,23 +45,23 @@ impl Method for Rk4 {
     ) -> Result<(Phase<N>, Option<Phase<N>>), E> {
         let mut k = [Phase::ZERO; 4];
         k[0] = *f0;
-        k[1] = f(t0 + h / 2.0, &y0.plus(h, &[(0.5, &k[0])]))?;
-        k[2] = f(t0 + h / 2.0, &y0.plus(h, &[(0.5, &k[1])]))?;
-        k[3] = f(t0 + h, &y0.plus(h, &[(1.0, &k[2])]))?;
+        k[1] = rhs(t0 + h / 2.0, &y0.plus(h, &[(0.5, &k[0])]))?;
+        k[2] = rhs(t0 + h / 2.0, &y0.plus(h, &[(0.5, &k[1])]))?;
+        k[3] = rhs(t0 + h, &y0.plus(h, &[(1.0, &k[2])]))?;
         let terms: [(f64, &Phase<N>); 4] = core::array::from_fn(|j| (WEIGHTS[j], &k[j]));
         Ok((y0.plus(h, &terms), None))
     }
 
     fn trial<const N: usize, E>(
         &self,
-        f: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
+        rhs: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
         y0: &Phase<N>,
         f0: &Phase<N>,
         t0: f64,
         h: f64,
     ) -> Result<Trial<N>, E> {
-        let (y1, _) = self.advance(f, y0, f0, t0, h)?;
-        let f1 = f(t0 + h, &y1)?;
+        let (y1, _) = self.advance(rhs, y0, f0, t0, h)?;
+        let f1 = rhs(t0 + h, &y1)?;
         Ok(Trial {
             y1,
             f1,
