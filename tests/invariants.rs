@@ -29,138 +29,227 @@ fn max_abs<const N: usize>(m: &[[f64; N]; N]) -> f64 {
     m.iter().flatten().fold(0.0_f64, |x, y| x.max(y.abs()))
 }
 
+/// What every per-wall check sees.
+struct At<'a, M: Walls<Q, N>, const Q: usize, const N: usize> {
+    model: &'a M,
+    wall: M::Wall,
+    name: &'static str,
+    q: &'a [f64; Q],
+    v: [f64; N],
+    g: [[f64; N]; N],
+    a: Rows<N>,
+    p: [[f64; N]; N],
+    scale: f64,
+}
+
 /// Checks every invariant for one model instance at (q, v).
 fn check<M: Walls<Q, N>, const Q: usize, const N: usize>(
     model: &M,
     q: &[f64; Q],
     v: [f64; N],
 ) -> Result<(), TestCaseError> {
-    let g = model.mass_matrix(q);
     let a = model.constraints(q);
     let v = onto_kernel(&a, v);
     for &wall in M::WALLS {
-        let name = M::wall_name(wall);
         let p = model.projector(wall, q);
-        let scale = max_abs(&p);
-        // P² = P
-        let p2 = mat_mul(&p, &p);
-        for i in 0..N {
-            for j in 0..N {
-                prop_assert!(
-                    close(p2[i][j], p[i][j], scale * scale),
-                    "{} {name}: P² ≠ P at ({i},{j})",
-                    M::NAME
-                );
-            }
-        }
-        // GP = PᵀG
-        let gp = mat_mul(&g, &p);
-        let gs = max_abs(&g) * scale;
-        for i in 0..N {
-            for j in 0..N {
-                let ptg: f64 = (0..N).map(|k| p[k][i] * g[k][j]).sum();
-                prop_assert!(
-                    close(gp[i][j], ptg, gs),
-                    "{} {name}: GP ≠ PᵀG at ({i},{j})",
-                    M::NAME
-                );
-            }
-        }
-        // The emitted normal and normal velocity are B's first row and
-        // that row times v.
-        let b = model.wall_rows(wall, q);
-        let row = b.as_slice()[0];
-        let normal = model.normal(wall, q);
-        let size = row.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let at = At {
+            model,
+            wall,
+            name: M::wall_name(wall),
+            q,
+            v,
+            g: model.mass_matrix(q),
+            a,
+            p,
+            scale: max_abs(&p),
+        };
+        projector_is_g_orthogonal(&at)?;
+        normal_is_b_first_row(&at)?;
+        rows_are_kept(&at)?;
+        collision_map(&at)?;
+    }
+    Ok(())
+}
+
+/// P² = P and GP = PᵀG (Lemma 1).
+fn projector_is_g_orthogonal<M: Walls<Q, N>, const Q: usize, const N: usize>(
+    at: &At<M, Q, N>,
+) -> Result<(), TestCaseError> {
+    let At {
+        name, g, p, scale, ..
+    } = *at;
+    // P² = P
+    let p2 = mat_mul(&p, &p);
+    for i in 0..N {
         for j in 0..N {
             prop_assert!(
-                close(normal[j], row[j], size),
-                "{} {name}: normal ≠ B's first row at {j}",
+                close(p2[i][j], p[i][j], scale * scale),
+                "{} {name}: P² ≠ P at ({i},{j})",
                 M::NAME
             );
         }
-        let nv: f64 = row.iter().zip(&v).map(|(x, y)| x * y).sum();
-        let vs = size * v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    }
+    // GP = PᵀG
+    let gp = mat_mul(&g, &p);
+    let gs = max_abs(&g) * scale;
+    for i in 0..N {
+        for j in 0..N {
+            let ptg: f64 = (0..N).map(|k| p[k][i] * g[k][j]).sum();
+            prop_assert!(
+                close(gp[i][j], ptg, gs),
+                "{} {name}: GP ≠ PᵀG at ({i},{j})",
+                M::NAME
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The emitted normal and normal velocity are B's first row and that row
+/// times v.
+fn normal_is_b_first_row<M: Walls<Q, N>, const Q: usize, const N: usize>(
+    at: &At<M, Q, N>,
+) -> Result<(), TestCaseError> {
+    let At {
+        model,
+        wall,
+        name,
+        q,
+        v,
+        ..
+    } = *at;
+    // The emitted normal and normal velocity are B's first row and
+    // that row times v.
+    let b = model.wall_rows(wall, q);
+    let row = b.as_slice()[0];
+    let normal = model.normal(wall, q);
+    let size = row.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    for j in 0..N {
         prop_assert!(
-            close(model.normal_velocity(wall, q, &v), nv, vs),
-            "{} {name}: normal velocity ≠ B's first row · v",
+            close(normal[j], row[j], size),
+            "{} {name}: normal ≠ B's first row at {j}",
             M::NAME
         );
-        // AP = A and BP = B
-        for (what, rows) in [("A", &a), ("B", &b)] {
-            for row in rows.as_slice() {
-                for j in 0..N {
-                    let rp: f64 = (0..N).map(|k| row[k] * p[k][j]).sum();
-                    prop_assert!(
-                        close(
-                            rp,
-                            row[j],
-                            scale * row.iter().fold(0.0_f64, |m, x| m.max(x.abs()))
-                        ),
-                        "{} {name}: {what}P ≠ {what} in column {j}",
-                        M::NAME
-                    );
-                }
-            }
-        }
-        // The generic numeric path gives the same P.
-        let p_generic =
-            projector(&g, b.as_slice()).map_err(|e| TestCaseError::fail(format!("{e:?}")))?;
-        for i in 0..N {
+    }
+    let nv: f64 = row.iter().zip(&v).map(|(x, y)| x * y).sum();
+    let vs = size * v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    prop_assert!(
+        close(model.normal_velocity(wall, q, &v), nv, vs),
+        "{} {name}: normal velocity ≠ B's first row · v",
+        M::NAME
+    );
+    Ok(())
+}
+
+/// AP = A, BP = B, and the generic numeric path gives the same P.
+fn rows_are_kept<M: Walls<Q, N>, const Q: usize, const N: usize>(
+    at: &At<M, Q, N>,
+) -> Result<(), TestCaseError> {
+    let At {
+        model,
+        wall,
+        name,
+        q,
+        g,
+        a,
+        p,
+        scale,
+        ..
+    } = *at;
+    let b = model.wall_rows(wall, q);
+    // AP = A and BP = B
+    for (what, rows) in [("A", &a), ("B", &b)] {
+        for row in rows.as_slice() {
             for j in 0..N {
+                let rp: f64 = (0..N).map(|k| row[k] * p[k][j]).sum();
                 prop_assert!(
-                    (p_generic[i][j] - p[i][j]).abs() <= 1e-7 * (1.0 + scale),
-                    "{} {name}: generated P differs from the generic path at ({i},{j}): {} vs {}",
-                    M::NAME,
-                    p[i][j],
-                    p_generic[i][j]
+                    close(
+                        rp,
+                        row[j],
+                        scale * row.iter().fold(0.0_f64, |m, x| m.max(x.abs()))
+                    ),
+                    "{} {name}: {what}P ≠ {what} in column {j}",
+                    M::NAME
                 );
             }
         }
-        // The collision map.
-        let vp = model.collide(wall, q, &v);
-        let e0 = kinetic_energy(&g, &v);
-        let e1 = kinetic_energy(&g, &vp);
-        prop_assert!(
-            close(e0, e1, e0.abs()),
-            "{} {name}: energy not kept: {e0} → {e1}",
-            M::NAME
-        );
-        prop_assert!(
-            close(model.kinetic_energy(q, &v), e0, e0.abs()),
-            "{} {name}: T(q,v) ≠ ½vᵀGv",
-            M::NAME
-        );
-        let vmax = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-        prop_assert!(
-            a.apply(&vp).max_abs() <= TOL * (1.0 + vmax * 10.0),
-            "{} {name}: v⁺ ∉ ker A",
-            M::NAME
-        );
-        let n0 = model.normal_velocity(wall, q, &v);
-        let n1 = model.normal_velocity(wall, q, &vp);
-        prop_assert!(
-            close(n1, -n0, vmax),
-            "{} {name}: normal velocity {n0} → {n1}, not reversed",
-            M::NAME
-        );
-        let back = model.collide(wall, q, &vp);
-        for i in 0..N {
+    }
+    // The generic numeric path gives the same P.
+    let p_generic =
+        projector(&g, b.as_slice()).map_err(|e| TestCaseError::fail(format!("{e:?}")))?;
+    for i in 0..N {
+        for j in 0..N {
             prop_assert!(
-                close(back[i], v[i], vmax),
-                "{} {name}: the collision map is not an involution",
-                M::NAME
+                (p_generic[i][j] - p[i][j]).abs() <= 1e-7 * (1.0 + scale),
+                "{} {name}: generated P differs from the generic path at ({i},{j}): {} vs {}",
+                M::NAME,
+                p[i][j],
+                p_generic[i][j]
             );
         }
-        // Same as (I − 2P)v computed from P.
-        let pv = mat_vec(&p, &v);
-        for i in 0..N {
-            prop_assert!(
-                close(vp[i], v[i] - 2.0 * pv[i], vmax * (1.0 + scale)),
-                "{} {name}: collide ≠ (I − 2P)v",
-                M::NAME
-            );
-        }
+    }
+    Ok(())
+}
+
+/// The collision map keeps T, maps ker A into ker A, reverses the normal
+/// velocity, is an involution and equals (I − 2P)v.
+fn collision_map<M: Walls<Q, N>, const Q: usize, const N: usize>(
+    at: &At<M, Q, N>,
+) -> Result<(), TestCaseError> {
+    let At {
+        model,
+        wall,
+        name,
+        q,
+        v,
+        g,
+        a,
+        p,
+        scale,
+    } = *at;
+    // The collision map.
+    let vp = model.collide(wall, q, &v);
+    let e0 = kinetic_energy(&g, &v);
+    let e1 = kinetic_energy(&g, &vp);
+    prop_assert!(
+        close(e0, e1, e0.abs()),
+        "{} {name}: energy not kept: {e0} → {e1}",
+        M::NAME
+    );
+    prop_assert!(
+        close(model.kinetic_energy(q, &v), e0, e0.abs()),
+        "{} {name}: T(q,v) ≠ ½vᵀGv",
+        M::NAME
+    );
+    let vmax = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    prop_assert!(
+        a.apply(&vp).max_abs() <= TOL * (1.0 + vmax * 10.0),
+        "{} {name}: v⁺ ∉ ker A",
+        M::NAME
+    );
+    let n0 = model.normal_velocity(wall, q, &v);
+    let n1 = model.normal_velocity(wall, q, &vp);
+    prop_assert!(
+        close(n1, -n0, vmax),
+        "{} {name}: normal velocity {n0} → {n1}, not reversed",
+        M::NAME
+    );
+    let back = model.collide(wall, q, &vp);
+    for i in 0..N {
+        prop_assert!(
+            close(back[i], v[i], vmax),
+            "{} {name}: the collision map is not an involution",
+            M::NAME
+        );
+    }
+    // Same as (I − 2P)v computed from P.
+    let pv = mat_vec(&p, &v);
+    for i in 0..N {
+        prop_assert!(
+            close(vp[i], v[i] - 2.0 * pv[i], vmax * (1.0 + scale)),
+            "{} {name}: collide ≠ (I − 2P)v",
+            M::NAME
+        );
     }
     Ok(())
 }
