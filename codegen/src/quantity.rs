@@ -42,15 +42,6 @@ pub enum Quantity {
     Collide,
 }
 
-/// Whether a quantity belongs to the model or to each wall.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Scope {
-    /// One function for the model.
-    Model,
-    /// One function per wall, named `{wall}_{name}`.
-    Wall,
-}
-
 /// What an emitted function returns.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Shape {
@@ -100,6 +91,12 @@ impl Capability {
         }
     }
 
+    /// Whether its quantities are one per wall (named `{wall}_{name}`)
+    /// rather than one for the model.
+    pub fn per_wall(self) -> bool {
+        matches!(self, Self::Walls | Self::Surfaces)
+    }
+
     /// Whether an instantaneous model (no coordinates) has it.
     pub fn instantaneous(self) -> bool {
         matches!(self, Self::Model | Self::Walls)
@@ -113,8 +110,6 @@ pub struct Spec {
     pub quantity: Quantity,
     /// The inherent function's name (for a wall, after `{wall}_`).
     pub name: &'static str,
-    /// Model-wide or per wall.
-    pub scope: Scope,
     /// Whether it takes the velocities as well as the coordinates.
     pub velocities: bool,
     /// What it returns.
@@ -133,7 +128,6 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::MassMatrix,
         name: "mass_matrix",
-        scope: Scope::Model,
         velocities: false,
         shape: Shape::Matrix,
         doc: "The mass matrix G(q).",
@@ -143,7 +137,6 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::KineticEnergy,
         name: "kinetic_energy",
-        scope: Scope::Model,
         velocities: true,
         shape: Shape::Scalar,
         doc: "Kinetic energy T(q, v).",
@@ -153,7 +146,6 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::Potential,
         name: "potential",
-        scope: Scope::Model,
         velocities: false,
         shape: Shape::Scalar,
         doc: "Potential energy V(q).",
@@ -163,7 +155,6 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::Constraints,
         name: "constraints",
-        scope: Scope::Model,
         velocities: false,
         shape: Shape::Rows,
         doc: "Rows of A(q).",
@@ -173,7 +164,6 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::Holonomic,
         name: "holonomic",
-        scope: Scope::Model,
         velocities: false,
         shape: Shape::Values,
         doc: "The holonomic constraints h(q) (zero on the constraint manifold); their differentials are the first rows of A.",
@@ -183,7 +173,6 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::Forcing,
         name: "forcing",
-        scope: Scope::Model,
         velocities: true,
         shape: Shape::Vector,
         doc: "h(q, q̇): the equations of motion are G(q) q̈ + h(q, q̇) = A(q)ᵀλ.",
@@ -193,7 +182,6 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::ConstraintDrift,
         name: "constraint_drift",
-        scope: Scope::Model,
         velocities: true,
         shape: Shape::Vector,
         doc: "Ȧq̇, one entry per row of A (the rest zero): A q̈ + Ȧq̇ = 0 along the motion.",
@@ -203,7 +191,6 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::Accelerations,
         name: "accelerations",
-        scope: Scope::Model,
         velocities: true,
         shape: Shape::Vector,
         doc: "q̈ of the equations of motion G(q) q̈ + h(q, q̇) = A(q)ᵀλ, A(q) q̈ + Ȧq̇ = 0, in closed form (q̇ should satisfy A(q) q̇ = 0). Non-finite where G is singular.",
@@ -213,7 +200,6 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::Surface,
         name: "surface",
-        scope: Scope::Wall,
         velocities: false,
         shape: Shape::Scalar,
         doc: "Wall `{wall}`: the surface function f(q).",
@@ -223,7 +209,6 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::Normal,
         name: "normal",
-        scope: Scope::Wall,
         velocities: false,
         shape: Shape::Vector,
         doc: "Wall `{wall}`: its normal df(q), the first row of B.",
@@ -233,7 +218,6 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::NormalVelocity,
         name: "normal_velocity",
-        scope: Scope::Wall,
         velocities: true,
         shape: Shape::Scalar,
         doc: "Wall `{wall}`: the normal velocity df(q)·v, negative while approaching.",
@@ -243,7 +227,6 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::SurfaceHessian,
         name: "surface_hessian",
-        scope: Scope::Wall,
         velocities: true,
         shape: Shape::Scalar,
         doc: "Wall `{wall}`: vᵀ∇²f(q)v; along a motion f̈ = df(q)·q̈ + vᵀ∇²f(q)v.",
@@ -253,7 +236,6 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::WallRows,
         name: "b_rows",
-        scope: Scope::Wall,
         velocities: false,
         shape: Shape::Rows,
         doc: "Wall `{wall}`: the independent rows of B(q), the normal velocity first.",
@@ -263,7 +245,6 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::Projector,
         name: "projector",
-        scope: Scope::Wall,
         velocities: false,
         shape: Shape::Matrix,
         doc: "Wall `{wall}`: the projector P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B.",
@@ -273,7 +254,6 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::Collide,
         name: "collide",
-        scope: Scope::Wall,
         velocities: true,
         shape: Shape::Vector,
         doc: "Wall `{wall}`: the collision map v⁺ = (I − 2P)v⁻.",
@@ -296,13 +276,15 @@ impl Quantity {
 mod tests {
     use super::*;
 
-    /// Every quantity has exactly one row, and names are unique per scope.
+    /// Every quantity has exactly one row, and names are unique among the
+    /// model's and among each wall's functions.
     #[test]
     fn one_row_per_quantity() {
         for (i, a) in TABLE.iter().enumerate() {
             for b in &TABLE[i + 1..] {
                 assert_ne!(a.quantity, b.quantity);
-                assert!(a.scope != b.scope || a.name != b.name, "{}", a.name);
+                let same_scope = a.capability.per_wall() == b.capability.per_wall();
+                assert!(!same_scope || a.name != b.name, "{}", a.name);
             }
             assert_eq!(a.quantity.spec().name, a.name);
         }

@@ -24,6 +24,8 @@ mod output;
 mod symbols;
 mod walls;
 
+use std::ops::Range;
+
 use symbolica::prelude::*;
 
 pub use output::{Derivation, Function, Geometry, Projection, WallDerivation};
@@ -56,10 +58,10 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
     let compile = Compiler {
         inputs: sym.inputs(),
         kind: model.kind,
-        span: Some(model.kinetic_energy.span.clone()),
     };
+    let t_span = &model.kinetic_energy.span;
     let g_flat: Vec<Atom> = exact.g.iter().flatten().cloned().collect();
-    let mass_matrix = compile.program(cx, Quantity::MassMatrix, &g_flat, 0)?;
+    let mass_matrix = compile.program(cx, Quantity::MassMatrix, &g_flat, 0, t_span)?;
     checks::positive_definite(&sym, cx, &mass_matrix.program);
     let g_inv = exact.inverse(&sym, cx)?;
     let context = walls::Context {
@@ -86,10 +88,10 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
         (Quantity::Forcing, raw.forcing.clone(), 0),
         (Quantity::ConstraintDrift, raw.drift.clone(), 0),
     ] {
-        functions.push(compile.applicable(cx, quantity, &outputs, rows)?);
+        functions.push(compile.applicable(cx, quantity, &outputs, rows, t_span)?);
     }
     if let Some(x) = &accelerations {
-        functions.push(compile.applicable(cx, Quantity::Accelerations, x, 0)?);
+        functions.push(compile.applicable(cx, Quantity::Accelerations, x, 0, t_span)?);
     }
     let functions = functions.into_iter().flatten().collect();
     Ok(Derivation {
@@ -107,19 +109,18 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
 struct Compiler {
     inputs: Vec<Atom>,
     kind: Kind,
-    /// Where a failure of the evaluator is reported.
-    span: Option<std::ops::Range<usize>>,
 }
 
 impl Compiler {
     /// The function for `quantity` computing `outputs` (`rows` of them in
-    /// use, for rows and values).
+    /// use, for rows and values); a failure is reported at `span`.
     fn program(
         &self,
         cx: &mut Collector,
         quantity: Quantity,
         outputs: &[Atom],
         rows: usize,
+        span: &Range<usize>,
     ) -> Result<Function, Reported> {
         evaluate::program(outputs, &self.inputs)
             .map(|program| Function {
@@ -127,7 +128,7 @@ impl Compiler {
                 program,
                 rows,
             })
-            .map_err(|e| cx.error(ErrorKind::Symbolic(e), self.span.clone()))
+            .map_err(|e| cx.error(ErrorKind::Symbolic(e), Some(span.clone())))
     }
 
     /// As [`Compiler::program`], where the model has the quantity (an
@@ -138,11 +139,12 @@ impl Compiler {
         quantity: Quantity,
         outputs: &[Atom],
         rows: usize,
+        span: &Range<usize>,
     ) -> Result<Option<Function>, Reported> {
         if self.kind == Kind::Instantaneous && !quantity.spec().capability.instantaneous() {
             return Ok(None);
         }
-        self.program(cx, quantity, outputs, rows).map(Some)
+        self.program(cx, quantity, outputs, rows, span).map(Some)
     }
 }
 

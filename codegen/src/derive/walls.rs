@@ -82,13 +82,22 @@ fn wall(
         (Quantity::SurfaceHessian, vec![low.reduce(&raw.hessian)], 0),
         (Quantity::WallRows, b_flat, b_atoms.len()),
     ] {
-        functions.extend(c.compile.applicable(cx, quantity, &outputs, rows)?);
+        functions.extend(
+            c.compile
+                .applicable(cx, quantity, &outputs, rows, &w.span)?,
+        );
     }
     let projection = match &closed {
         Some((p, collide)) => {
             let flat: Vec<Atom> = p.iter().flatten().cloned().collect();
-            functions.extend(c.compile.applicable(cx, Quantity::Projector, &flat, 0)?);
-            functions.extend(c.compile.applicable(cx, Quantity::Collide, collide, 0)?);
+            functions.extend(
+                c.compile
+                    .applicable(cx, Quantity::Projector, &flat, 0, &w.span)?,
+            );
+            functions.extend(
+                c.compile
+                    .applicable(cx, Quantity::Collide, collide, 0, &w.span)?,
+            );
             Projection::ClosedForm {
                 projector: strings(p),
                 collision: collide

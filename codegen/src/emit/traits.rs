@@ -9,7 +9,7 @@ use quote::{format_ident, quote};
 use super::functions::dims;
 use super::{Ctx, ident};
 use crate::ir::{Kind, camel};
-use crate::quantity::{Capability, Forward, Scope, Shape, Spec, TABLE};
+use crate::quantity::{Capability, Forward, Shape, Spec, TABLE};
 
 pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
     let ty = format_ident!("{}", d.model.type_name());
@@ -111,23 +111,20 @@ fn forward(d: &Ctx, spec: &Spec, variants: &[Ident]) -> Option<TokenStream> {
         Forward::Plain => ty,
         Forward::Some => quote! { Option<#ty> },
     };
-    let (params, value) = match spec.scope {
-        Scope::Model => {
-            d.function(spec.quantity)?;
-            let f = format_ident!("{}", spec.name);
-            (params, wrapped(quote! { self.#f(#args) }))
-        }
-        Scope::Wall => {
-            let arms = d.walls.iter().zip(variants).map(|(w, v)| {
-                let f = format_ident!("{}_{}", w.name, spec.name);
-                let value = wrapped(quote! { self.#f(#args) });
-                quote! { Wall::#v => #value }
-            });
-            (
-                quote! { wall: Wall, #params },
-                quote! { match wall { #(#arms,)* } },
-            )
-        }
+    let (params, value) = if !spec.capability.per_wall() {
+        d.function(spec.quantity)?;
+        let f = format_ident!("{}", spec.name);
+        (params, wrapped(quote! { self.#f(#args) }))
+    } else {
+        let arms = d.walls.iter().zip(variants).map(|(w, v)| {
+            let f = format_ident!("{}_{}", w.name, spec.name);
+            let value = wrapped(quote! { self.#f(#args) });
+            quote! { Wall::#v => #value }
+        });
+        (
+            quote! { wall: Wall, #params },
+            quote! { match wall { #(#arms,)* } },
+        )
     };
     Some(quote! {
         #[inline]
