@@ -10,8 +10,7 @@ use dalembert::for_each_model;
 use dalembert::models::*;
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
-    DormandPrince, Integrator, Residual, Rk4, Settings, Simulator, State, Step, admissible,
-    residual,
+    DormandPrince, Integrator, Residual, Rk4, Settings, Simulator, State, admissible, residual,
 };
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -128,35 +127,84 @@ pub struct Row<const N: usize> {
     pub event: Option<&'static str>,
 }
 
-fn run<M: Surfaces<N>, const N: usize>(args: &SimulateArgs) -> Result<bool, String> {
-    let (model, start, start_residual) = start::<M, N>(args)?;
-    let mut sim = Simulator::new(&model, start, settings(args)).map_err(|e| e.to_string())?;
+/// Most rows a run may write (CSV rows at the `--every` spacing).
+const MAX_ROWS: f64 = 1e7;
+/// Most fixed steps a run may take.
+const MAX_STEPS: f64 = 1e10;
+/// Rows kept in memory for the plot; the CSV has them all.
+const PLOT_ROWS: usize = 4000;
+
+/// The run's settings checked before anything runs: finite, positive and
+/// within bounds that keep time and output reasonable.
+fn checked_spacing(args: &SimulateArgs) -> Result<f64, String> {
+    let positive = |name: &str, x: f64| {
+        if x.is_finite() && x > 0.0 {
+            Ok(())
+        } else {
+            Err(format!("{name} must be a positive finite number (got {x})"))
+        }
+    };
+    positive("--t-end", args.t_end)?;
     let every = args.every.unwrap_or(args.t_end / 2000.0);
-    if !(every > 0.0 && args.t_end > 0.0) {
-        return Err("--t-end and --every must be positive".into());
+    positive("--every", every)?;
+    if args.t_end / every > MAX_ROWS {
+        return Err(format!(
+            "--t-end {} with --every {every} would write {:.1e} rows; the limit is {MAX_ROWS:.0e}: raise --every",
+            args.t_end,
+            args.t_end / every
+        ));
     }
+    match args.integrator {
+        Method::Rk4 => {
+            positive("--step", args.step)?;
+            if args.t_end / args.step > MAX_STEPS {
+                return Err(format!(
+                    "--t-end {} with --step {} would take {:.1e} steps; the limit is {MAX_STEPS:.0e}",
+                    args.t_end,
+                    args.step,
+                    args.t_end / args.step
+                ));
+            }
+        }
+        Method::DormandPrince => {
+            positive("--rtol", args.rtol)?;
+            positive("--atol", args.atol)?;
+        }
+    }
+    Ok(every)
+}
+
+fn run<M: Surfaces<N>, const N: usize>(args: &SimulateArgs) -> Result<bool, String> {
+    let every = checked_spacing(args)?;
+    let path = path_axes::<M, N>(args.path.as_deref())?;
+    let (model, start, start_residual) = start::<M, N>(args)?;
     let e0 = model.energy(&start.q, &start.v);
-    let mut rows = vec![Row {
+    if !e0.is_finite() {
+        return Err(format!(
+            "the initial energy is {e0}: the initial state is out of range for f64"
+        ));
+    }
+    let mut sim = Simulator::new(&model, start, settings(args)).map_err(|e| e.to_string())?;
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
+    let csv = args.out.join(format!("{}.csv", M::NAME));
+    let svg = args.out.join(format!("{}.svg", M::NAME));
+    let mut out = Output::<N>::create::<M>(&csv, e0)?;
+    out.push::<M>(Row {
         t: 0.0,
         q: start.q,
         v: start.v,
         energy: e0,
         residual: [start_residual.velocity, start_residual.position],
         event: None,
-    }];
+    })?;
     let clock = Instant::now();
-    let failure = integrate(&mut sim, args.t_end, every, &mut rows)?;
+    let failure = integrate(&mut sim, args.t_end, every, &mut out)?;
     let elapsed = clock.elapsed();
-
-    std::fs::create_dir_all(&args.out)
-        .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
-    let csv = args.out.join(format!("{}.csv", M::NAME));
-    let svg = args.out.join(format!("{}.svg", M::NAME));
-    write_csv::<M, N>(&csv, &rows)?;
-    let path = path_axes::<M, N>(args.path.as_deref())?;
-    plot::<M, N>(&svg, &rows, path, e0)?;
-    summary(&sim, args, &rows, e0, elapsed.as_secs_f64());
-    println!("  trajectory: {}", csv.display());
+    out.finish()?;
+    plot::<M, N>(&svg, &out.kept, path, e0)?;
+    summary(&sim, args, &out, e0, elapsed.as_secs_f64());
+    println!("  trajectory: {} ({} rows)", csv.display(), out.written);
     println!("  plot:       {}", svg.display());
     match failure {
         Some(e) => {
@@ -164,6 +212,95 @@ fn run<M: Surfaces<N>, const N: usize>(args: &SimulateArgs) -> Result<bool, Stri
             Ok(false)
         }
         None => Ok(true),
+    }
+}
+
+/// Where the rows go: the CSV file as they come, a thinned copy for the
+/// plot, and the largest energy drift and residuals over every row.
+struct Output<const N: usize> {
+    file: std::io::BufWriter<std::fs::File>,
+    path: PathBuf,
+    /// Rows for the plot: every `stride`-th row and every collision.
+    kept: Vec<Row<N>>,
+    stride: usize,
+    written: usize,
+    e0: f64,
+    drift: f64,
+    worst: [f64; 2],
+}
+
+impl<const N: usize> Output<N> {
+    fn create<M: Surfaces<N>>(path: &Path, e0: f64) -> Result<Self, String> {
+        let file = std::fs::File::create(path)
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        let mut out = Self {
+            file: std::io::BufWriter::new(file),
+            path: path.to_path_buf(),
+            kept: Vec::new(),
+            stride: 1,
+            written: 0,
+            e0,
+            drift: 0.0,
+            worst: [0.0; 2],
+        };
+        let mut header = String::from("t");
+        for name in M::COORDINATES.iter().chain(M::VELOCITIES) {
+            header.push(',');
+            header.push_str(name);
+        }
+        header.push_str(",energy,residual_velocity,residual_position,collision\n");
+        out.write(&header)?;
+        Ok(out)
+    }
+
+    fn write(&mut self, text: &str) -> Result<(), String> {
+        use std::io::Write as _;
+        self.file
+            .write_all(text.as_bytes())
+            .map_err(|e| format!("cannot write {}: {e}", self.path.display()))
+    }
+
+    fn push<M: Surfaces<N>>(&mut self, r: Row<N>) -> Result<(), String> {
+        let mut line = String::new();
+        let _ = write!(line, "{:e}", r.t);
+        for x in r.q.iter().chain(&r.v) {
+            let _ = write!(line, ",{x:e}");
+        }
+        let _ = writeln!(
+            line,
+            ",{:e},{:e},{:e},{}",
+            r.energy,
+            r.residual[0],
+            r.residual[1],
+            r.event.unwrap_or("")
+        );
+        self.write(&line)?;
+        self.drift = self.drift.max((r.energy - self.e0).abs());
+        self.worst = [
+            self.worst[0].max(r.residual[0]),
+            self.worst[1].max(r.residual[1]),
+        ];
+        if self.written % self.stride == 0 || r.event.is_some() {
+            self.kept.push(r);
+        }
+        self.written += 1;
+        if self.kept.len() > 2 * PLOT_ROWS {
+            // Thin to every other row, keeping collisions.
+            let mut k = 0;
+            self.kept.retain(|r| {
+                k += 1;
+                k % 2 == 1 || r.event.is_some()
+            });
+            self.stride *= 2;
+        }
+        Ok(())
+    }
+
+    fn finish(&mut self) -> Result<(), String> {
+        use std::io::Write as _;
+        self.file
+            .flush()
+            .map_err(|e| format!("cannot write {}: {e}", self.path.display()))
     }
 }
 
@@ -176,13 +313,11 @@ fn start<M: Surfaces<N>, const N: usize>(
     let mut q = M::INITIAL_COORDINATES;
     let mut v = M::INITIAL_VELOCITIES;
     for (name, value) in &args.set {
-        if let Some(i) = M::PARAMETERS.iter().position(|p| p == name) {
-            model.set_parameter(i, *value);
-        } else if let Some(i) = M::COORDINATES.iter().position(|c| c == name) {
+        if let Some(i) = M::COORDINATES.iter().position(|c| c == name) {
             q[i] = *value;
         } else if let Some(i) = M::VELOCITIES.iter().position(|c| c == name) {
             v[i] = *value;
-        } else {
+        } else if !model.set_parameter_named(name, *value) {
             return Err(format!(
                 "`{name}` is not a parameter ({}), coordinate ({}) or velocity ({}) of {}",
                 M::PARAMETERS.join(", "),
@@ -235,7 +370,7 @@ fn integrate<M: Surfaces<N>, const N: usize>(
     sim: &mut Simulator<'_, M, N>,
     t_end: f64,
     every: f64,
-    rows: &mut Vec<Row<N>>,
+    out: &mut Output<N>,
 ) -> Result<Option<String>, String> {
     let bar = ProgressBar::new(1000);
     bar.set_style(
@@ -246,20 +381,51 @@ fn integrate<M: Surfaces<N>, const N: usize>(
         .progress_chars("=> "),
     );
     bar.set_message(format!("simulating {}", M::NAME));
-    let mut next = every;
+    let mut k = 1.0;
     let mut failure = None;
+    let mut last_energy = out.e0;
     while sim.state().t < t_end {
-        let target = next.min(t_end);
-        match sim.step(target) {
-            Ok(step) => record::<M, N>(rows, &step),
+        let target = (k * every).min(t_end);
+        let step = match sim.step(target) {
+            Ok(step) => step,
             Err(e) => {
                 failure = Some(e.to_string());
                 break;
             }
+        };
+        let residual = [step.residual.velocity, step.residual.position];
+        if let Some(c) = &step.collision {
+            // The state just before the collision, from its record.
+            out.push::<M>(Row {
+                t: c.t,
+                q: c.q,
+                v: c.v_minus,
+                energy: last_energy,
+                residual,
+                event: Some(M::wall_name(c.wall)),
+            })?;
         }
-        if sim.state().t >= target {
-            next += every;
-            bar.set_position((1000.0 * sim.state().t / t_end) as u64);
+        last_energy = step.energy;
+        let s = &step.state;
+        if !step.energy.is_finite() {
+            failure = Some(format!("the energy became {} at t = {}", step.energy, s.t));
+        }
+        if s.t >= target || step.collision.is_some() || failure.is_some() {
+            out.push::<M>(Row {
+                t: s.t,
+                q: s.q,
+                v: s.v,
+                energy: step.energy,
+                residual,
+                event: None,
+            })?;
+        }
+        if failure.is_some() {
+            break;
+        }
+        if s.t >= target {
+            k += 1.0;
+            bar.set_position((1000.0 * s.t / t_end) as u64);
         }
     }
     bar.finish_and_clear();
@@ -270,17 +436,11 @@ fn integrate<M: Surfaces<N>, const N: usize>(
 fn summary<M: Surfaces<N>, const N: usize>(
     sim: &Simulator<'_, M, N>,
     args: &SimulateArgs,
-    rows: &[Row<N>],
+    out: &Output<N>,
     e0: f64,
     secs: f64,
 ) {
     let stats = sim.stats();
-    let drift = rows
-        .iter()
-        .fold(0.0f64, |m, r| m.max((r.energy - e0).abs()));
-    let worst = rows.iter().fold([0.0f64; 2], |m, r| {
-        [m[0].max(r.residual[0]), m[1].max(r.residual[1])]
-    });
     println!(
         "{}: t = 0 → {} with {:?}",
         M::NAME,
@@ -298,61 +458,14 @@ fn summary<M: Surfaces<N>, const N: usize>(
         stats.collisions as f64 / secs
     );
     println!(
-        "  energy {e0:.12} at the start; largest |E − E₀| = {drift:.2e} (relative {:.2e})",
-        drift / e0.abs().max(f64::MIN_POSITIVE)
+        "  energy {e0:.12} at the start; largest |E − E₀| over the rows = {:.2e} (relative {:.2e})",
+        out.drift,
+        out.drift / e0.abs().max(f64::MIN_POSITIVE)
     );
     println!(
-        "  largest constraint residuals: |A q̇| = {:.2e}, |h(q)| = {:.2e}",
-        worst[0], worst[1]
+        "  largest constraint residuals over the rows: |A q̇| = {:.2e}, |h(q)| = {:.2e}",
+        out.worst[0], out.worst[1]
     );
-}
-
-fn record<M: Surfaces<N>, const N: usize>(rows: &mut Vec<Row<N>>, step: &Step<M::Wall, N>) {
-    if let Some(c) = &step.collision {
-        // The state just before the collision, from its record.
-        let last = rows.last().map_or(step.energy, |r| r.energy);
-        rows.push(Row {
-            t: c.t,
-            q: c.q,
-            v: c.v_minus,
-            energy: last,
-            residual: [step.residual.velocity, step.residual.position],
-            event: Some(M::wall_name(c.wall)),
-        });
-    }
-    let s = &step.state;
-    rows.push(Row {
-        t: s.t,
-        q: s.q,
-        v: s.v,
-        energy: step.energy,
-        residual: [step.residual.velocity, step.residual.position],
-        event: None,
-    });
-}
-
-fn write_csv<M: Surfaces<N>, const N: usize>(file: &Path, rows: &[Row<N>]) -> Result<(), String> {
-    let mut out = String::from("t");
-    for name in M::COORDINATES.iter().chain(M::VELOCITIES) {
-        out.push(',');
-        out.push_str(name);
-    }
-    out.push_str(",energy,residual_velocity,residual_position,collision\n");
-    for r in rows {
-        let _ = write!(out, "{:e}", r.t);
-        for x in r.q.iter().chain(&r.v) {
-            let _ = write!(out, ",{x:e}");
-        }
-        let _ = writeln!(
-            out,
-            ",{:e},{:e},{:e},{}",
-            r.energy,
-            r.residual[0],
-            r.residual[1],
-            r.event.unwrap_or("")
-        );
-    }
-    std::fs::write(file, out).map_err(|e| format!("cannot write {}: {e}", file.display()))
 }
 
 /// Indices of the two coordinates drawn as the path.

@@ -48,6 +48,10 @@ pub enum ErrorKind {
     /// An expression is malformed.
     #[error("malformed expression: {0}")]
     Syntax(String),
+    /// A model exceeds a limit that keeps derivation time and memory
+    /// bounded.
+    #[error("too large: {0}")]
+    Limit(String),
     /// A parameter value is not an exact finite number.
     #[error("parameter `{name}`: {why}")]
     BadParameter {
@@ -100,6 +104,10 @@ pub enum ErrorKind {
         /// The sample point.
         at: String,
     },
+    /// An expression has no finite real value (a division by zero, the
+    /// logarithm of 0, the square root of a negative number).
+    #[error("the expression is undefined: {0}")]
+    Domain(String),
     /// The symbolic engine reported a failure.
     #[error("symbolic derivation failed: {0}")]
     Symbolic(String),
@@ -158,16 +166,32 @@ impl ModelErrors {
         let handler = GraphicalReportHandler::new_themed(GraphicalTheme::unicode_nocolor());
         let mut out = String::new();
         for d in &self.errors {
+            // miette cannot draw a marker far out on a very long line (it
+            // panics past column 65535): such errors keep their
+            // file:line:col but are shown without the snippet.
+            let drawable = d.span.as_ref().filter(|s| {
+                let line = self
+                    .source
+                    .get(..s.start)
+                    .map_or(0, |b| b.rfind('\n').map_or(0, |i| i + 1));
+                let end = self.source[line..]
+                    .find('\n')
+                    .map_or(self.source.len(), |i| line + i);
+                end - line <= MAX_DRAWN_LINE && s.end <= self.source.len()
+            });
             let report = Rendered {
                 message: format!("{}:{}:{}: {}", self.file.display(), d.line, d.col, d.kind),
                 source: NamedSource::new(self.file.display().to_string(), self.source.clone()),
-                span: d.span.clone().map(|s| (s.start, s.end - s.start).into()),
+                span: drawable.map(|s| (s.start, s.end - s.start).into()),
             };
             let _ = handler.render_report(&mut out, &report);
         }
         out
     }
 }
+
+/// Longest line (in bytes) whose errors are drawn with a snippet.
+const MAX_DRAWN_LINE: usize = 4096;
 
 #[derive(Debug)]
 struct Rendered {

@@ -65,6 +65,26 @@ pub fn generate_with(path: &Path, options: Options) -> Result<String, ModelError
         );
         return cx.conclude(Err(e));
     }
+    if options.scalar == Scalar::F32 {
+        let functions = d
+            .functions
+            .iter()
+            .chain(d.walls.iter().flat_map(|w| &w.functions));
+        let too_large = functions
+            .filter(|f| f.program.consts.iter().any(|c| c.abs() > f32::MAX as f64))
+            .map(|f| f.quantity.spec().name)
+            .next();
+        if let Some(name) = too_large {
+            let mut cx = diag::Collector::new(&d.model.file, &d.model.source);
+            let e = cx.error(
+                ErrorKind::Limit(format!(
+                    "a constant of `{name}` exceeds f32's range (about 3.4e38): generate f64 code"
+                )),
+                Some(d.model.kinetic_energy.span.clone()),
+            );
+            return cx.conclude(Err(e));
+        }
+    }
     Ok(emit::file(&d, options))
 }
 

@@ -9,7 +9,8 @@
 //! process the lock is taken once; callers must still not use the engine
 //! from two threads at once.
 
-use std::fs::{File, OpenOptions};
+use std::fs::{File, OpenOptions, TryLockError};
+use std::io::Write as _;
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
@@ -27,7 +28,8 @@ pub fn lock_path() -> PathBuf {
     std::env::temp_dir().join(format!("dalembert-codegen-{user}.lock"))
 }
 
-/// Blocks until this process holds the lock; afterwards returns at once.
+/// Blocks until this process holds the lock (saying on standard error whom
+/// it waits for, when it has to); afterwards returns at once.
 pub fn acquire() -> Result<(), String> {
     HELD.get_or_init(|| {
         let path = lock_path();
@@ -37,8 +39,29 @@ pub fn acquire() -> Result<(), String> {
             .write(true)
             .open(&path)
             .map_err(|e| format!("cannot open the lock file {}: {e}", path.display()))?;
-        file.lock()
-            .map_err(|e| format!("cannot lock {}: {e}", path.display()))?;
+        let cannot = |e: std::io::Error| format!("cannot lock {}: {e}", path.display());
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(TryLockError::WouldBlock) => {
+                let holder = std::fs::read_to_string(&path).unwrap_or_default();
+                let holder = holder.trim();
+                eprintln!(
+                    "waiting for the symbolic engine: {} holds {} (without a licence key symbolica serves one process per user)",
+                    if holder.is_empty() { "another process" } else { holder },
+                    path.display()
+                );
+                file.lock().map_err(cannot)?;
+            }
+            Err(TryLockError::Error(e)) => return Err(cannot(e)),
+        }
+        // Say who holds it, for whoever waits next.
+        let mut file = file;
+        let me = format!(
+            "process {} ({})",
+            std::process::id(),
+            std::env::args().collect::<Vec<_>>().join(" ")
+        );
+        let _ = file.set_len(0).and_then(|()| file.write_all(me.as_bytes()));
         Ok(file)
     })
     .as_ref()

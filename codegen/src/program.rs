@@ -25,13 +25,11 @@ pub enum Func {
     Sin,
     /// cos
     Cos,
-    /// tan
-    Tan,
     /// exp
     Exp,
     /// natural log
     Log,
-    /// square root
+    /// square root (the evaluator's form of a power ½)
     Sqrt,
 }
 
@@ -41,7 +39,6 @@ impl Func {
         Some(match name {
             "sin" => Self::Sin,
             "cos" => Self::Cos,
-            "tan" => Self::Tan,
             "exp" => Self::Exp,
             "log" => Self::Log,
             "sqrt" => Self::Sqrt,
@@ -54,7 +51,6 @@ impl Func {
         match self {
             Self::Sin => "sin",
             Self::Cos => "cos",
-            Self::Tan => "tan",
             Self::Exp => "exp",
             Self::Log => "log",
             Self::Sqrt => "sqrt",
@@ -66,7 +62,6 @@ impl Func {
         match self {
             Self::Sin => x.sin(),
             Self::Cos => x.cos(),
-            Self::Tan => x.tan(),
             Self::Exp => x.exp(),
             Self::Log => x.ln(),
             Self::Sqrt => x.sqrt(),
@@ -83,6 +78,8 @@ pub enum Instr {
     Mul(Slot, Vec<Slot>),
     /// dst = src^n
     Pow(Slot, Slot, i64),
+    /// dst = src^x for a fractional constant x (½ is a square root)
+    Powf(Slot, Slot, f64),
     /// dst = f(src)
     Fun(Slot, Func, Slot),
     /// dst = src
@@ -111,7 +108,7 @@ pub struct OpCount {
     pub mul: usize,
     /// Divisions (negative powers).
     pub div: usize,
-    /// Function calls (sin, cos, ...).
+    /// Function calls (sin, cos, ..., and fractional powers).
     pub fun: usize,
 }
 
@@ -164,6 +161,7 @@ impl Program {
                 Instr::Add(d, s) => (*d, s.iter().map(|&x| get(x, &temps, &outs)).sum()),
                 Instr::Mul(d, s) => (*d, s.iter().map(|&x| get(x, &temps, &outs)).product()),
                 Instr::Pow(d, s, n) => (*d, get(*s, &temps, &outs).powi(*n as i32)),
+                Instr::Powf(d, s, x) => (*d, powf(get(*s, &temps, &outs), *x)),
                 Instr::Fun(d, f, s) => (*d, f.apply(get(*s, &temps, &outs))),
                 Instr::Assign(d, s) => (*d, get(*s, &temps, &outs)),
             };
@@ -195,10 +193,21 @@ impl Program {
                         c.div += 1;
                     }
                 }
-                Instr::Fun(..) => c.fun += 1,
+                Instr::Fun(..) | Instr::Powf(..) => c.fun += 1,
                 Instr::Assign(..) => {}
             }
         }
         c
+    }
+}
+
+/// x^e as the emitted code computes it: a square root where e = ±½.
+pub fn powf(x: f64, e: f64) -> f64 {
+    if e == 0.5 {
+        x.sqrt()
+    } else if e == -0.5 {
+        1.0 / x.sqrt()
+    } else {
+        x.powf(e)
     }
 }

@@ -81,6 +81,23 @@ impl Reference {
     /// Compares with `d`.
     #[allow(clippy::needless_range_loop)] // matrix code reads best with indices
     pub fn compare(&self, d: &Derivation) -> Result<Comparison, String> {
+        if self.model != d.model.name {
+            return Err(format!(
+                "the reference is for model `{}`, and the model file is `{}`",
+                self.model, d.model.name
+            ));
+        }
+        if let Some(bad) = self
+            .admissible
+            .keys()
+            .find(|k| !d.model.velocities.contains(k))
+        {
+            return Err(format!(
+                "[admissible] `{bad}` is not a velocity of `{}` (its velocities: {})",
+                d.model.name,
+                d.model.velocities.join(", ")
+            ));
+        }
         let wall = d
             .walls
             .iter()

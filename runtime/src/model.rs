@@ -30,6 +30,20 @@ pub trait Model<const Q: usize, const N: usize> {
     fn parameter(&self, index: usize) -> Option<f64>;
     /// Sets parameter `index`; false when there is no such parameter.
     fn set_parameter(&mut self, index: usize, value: f64) -> bool;
+    /// The value of the parameter called `name`, if the model has one.
+    /// (Derived parameters are not parameters of the generated code: they
+    /// are computed from the others wherever they are used.)
+    fn parameter_named(&self, name: &str) -> Option<f64> {
+        let index = Self::PARAMETERS.iter().position(|p| *p == name)?;
+        self.parameter(index)
+    }
+    /// Sets the parameter called `name`; false when the model has none.
+    fn set_parameter_named(&mut self, name: &str, value: f64) -> bool {
+        match Self::PARAMETERS.iter().position(|p| *p == name) {
+            Some(index) => self.set_parameter(index, value),
+            None => false,
+        }
+    }
 
     /// The mass matrix G(q): T = ½ vᵀ G(q) v.
     fn mass_matrix(&self, q: &[f64; Q]) -> [[f64; N]; N];

@@ -5,9 +5,13 @@
 use symbolica::evaluate::{Instruction, Slot as ESlot};
 use symbolica::prelude::*;
 
+use super::build::{constant_symbol, own_constants};
+use crate::ir::Constant;
 use crate::program::{Func, Instr, Program, Slot};
 
-/// An optimised program for `outputs` in terms of `inputs`.
+/// An optimised program for `outputs` in terms of `inputs`. π and e enter
+/// as two extra inputs, which become constants of the program with their
+/// values; every constant is checked to be a finite real number.
 pub fn program(outputs: &[Atom], inputs: &[Atom]) -> Result<Program, String> {
     if outputs.is_empty() {
         return Ok(Program {
@@ -17,12 +21,38 @@ pub fn program(outputs: &[Atom], inputs: &[Atom]) -> Result<Program, String> {
             outputs: 0,
         });
     }
-    let ev = Atom::evaluator_multiple(outputs, inputs)
+    let constants = [Constant::Pi, Constant::E];
+    let mut all_inputs = inputs.to_vec();
+    all_inputs.extend(constants.map(|c| Atom::from(constant_symbol(c))));
+    let outputs: Vec<Atom> = outputs.iter().map(own_constants).collect();
+    let ev = Atom::evaluator_multiple(&outputs, &all_inputs)
         .optimization_settings(OptimizationSettings::default())
         .build()
         .map_err(|e| format!("{e:?}"))?;
     let ex = ev.export_instructions();
-    let consts: Vec<f64> = ex.constants.iter().map(|c| c.re.to_f64()).collect();
+    let mut consts = Vec::with_capacity(ex.constants.len() + 2);
+    for c in &ex.constants {
+        let (re, im) = (c.re.to_f64(), c.im.to_f64());
+        if im != 0.0 {
+            return Err(format!(
+                "the expression is not real (a constant {re} + {im}i)"
+            ));
+        }
+        if !re.is_finite() {
+            return Err("a constant of the expression is too large for f64 (or infinite)".into());
+        }
+        consts.push(re);
+    }
+    // The extra inputs become the last constants.
+    let first_constant = consts.len();
+    consts.extend(constants.map(Constant::value));
+    let slot = |s: &ESlot| match s {
+        ESlot::Param(i) if *i >= inputs.len() => Slot::Const(first_constant + i - inputs.len()),
+        ESlot::Param(i) => Slot::Input(*i),
+        ESlot::Const(i) => Slot::Const(*i),
+        ESlot::Temp(i) => Slot::Temp(*i),
+        ESlot::Out(i) => Slot::Out(*i),
+    };
     let slots = |v: &[ESlot]| v.iter().map(slot).collect::<Vec<_>>();
     let mut instrs = Vec::new();
     for ins in &ex.instructions {
@@ -30,6 +60,12 @@ pub fn program(outputs: &[Atom], inputs: &[Atom]) -> Result<Program, String> {
             Instruction::Add(d, s, _) => Instr::Add(slot(d), slots(s)),
             Instruction::Mul(d, s, _) => Instr::Mul(slot(d), slots(s)),
             Instruction::Pow(d, s, n, _) => Instr::Pow(slot(d), slot(s), *n),
+            Instruction::Powf(d, s, e, _) => match (slot(s), slot(e)) {
+                (_, Slot::Const(k)) => Instr::Powf(slot(d), slot(s), consts[k]),
+                // symbolica writes exp(x) as e^x.
+                (Slot::Const(k), x) if k == first_constant + 1 => Instr::Fun(slot(d), Func::Exp, x),
+                _ => return Err(format!("a power with a variable exponent: {ins:?}")),
+            },
             Instruction::Assign(d, s) => Instr::Assign(slot(d), slot(s)),
             Instruction::Fun(d, call, _) => {
                 let (f, _, args) = call.as_ref();
@@ -50,13 +86,4 @@ pub fn program(outputs: &[Atom], inputs: &[Atom]) -> Result<Program, String> {
         instrs,
         outputs: ex.output_count,
     })
-}
-
-fn slot(s: &ESlot) -> Slot {
-    match s {
-        ESlot::Param(i) => Slot::Input(*i),
-        ESlot::Const(i) => Slot::Const(*i),
-        ESlot::Temp(i) => Slot::Temp(*i),
-        ESlot::Out(i) => Slot::Out(*i),
-    }
 }

@@ -1,47 +1,50 @@
 //! Symbolic helpers for front ends and tests: equality of expressions,
-//! symbolica's own evaluation (an independent path from emitted code),
-//! substitution and LaTeX. Each takes the generator's lock first.
+//! evaluation by the generator's own programs (an independent path from
+//! emitted code), substitution and LaTeX. Expressions are read with the
+//! model language's parser (and what symbolica prints reads back). Each
+//! takes the generator's lock first.
+
+use std::collections::HashMap;
 
 use symbolica::prelude::*;
 
-use super::is_zero;
+use super::build::{build, model_symbol};
+use super::evaluate::program;
+use super::lower::vanishes;
 
-/// Whether two expressions (in the model's names) are equal as rational
-/// functions.
-pub fn same(a: &str, b: &str) -> Result<bool, String> {
-    crate::lock::acquire()?;
-    let a = try_parse!(a)?;
-    let b = try_parse!(b)?;
-    Ok(is_zero(&(a - b)))
+/// `text` as an expression of the model language.
+fn atom(text: &str) -> Result<Atom, String> {
+    let node = crate::ir::expr::parse(text).map_err(|e| format!("`{text}`: {}", e.message))?;
+    build(&node, &HashMap::new()).map_err(|e| format!("`{text}`: {}", e.message))
 }
 
-/// Evaluates `expr` at the given values with symbolica's own evaluator (an
-/// independent path from the emitted code).
+/// Whether two expressions (in the model's names) are equal as rational
+/// functions of the names and the function applications, sin² + cos² = 1
+/// taken into account.
+pub fn same(a: &str, b: &str) -> Result<bool, String> {
+    crate::lock::acquire()?;
+    Ok(vanishes(&(atom(a)? - atom(b)?)))
+}
+
+/// Evaluates `expr` at the given values.
 pub fn eval(expr: &str, values: &[(&str, f64)]) -> Result<f64, String> {
     crate::lock::acquire()?;
-    let e = try_parse!(expr)?;
+    let e = atom(expr)?;
     let inputs: Vec<Atom> = values
         .iter()
-        .map(|(n, _)| Atom::from(symbol!(*n)))
+        .map(|(n, _)| Atom::from(model_symbol(n)))
         .collect();
-    let ev = Atom::evaluator_multiple(std::slice::from_ref(&e), &inputs)
-        .optimization_settings(OptimizationSettings::default())
-        .build()
-        .map_err(|e| format!("{e:?}"))?;
-    let mut ev = ev.map_coeff(&|x| x.re.to_f64());
+    let p = program(std::slice::from_ref(&e), &inputs)?;
     let xs: Vec<f64> = values.iter().map(|(_, v)| *v).collect();
-    let mut out = [0.0];
-    ev.evaluate(&xs, &mut out);
-    Ok(out[0])
+    Ok(p.eval(&xs)[0])
 }
 
 /// `expr` with each named symbol replaced by an expression.
 pub fn substitute(expr: &str, subs: &[(&str, &str)]) -> Result<String, String> {
     crate::lock::acquire()?;
-    let mut e = try_parse!(expr)?;
+    let mut e = atom(expr)?;
     for (name, value) in subs {
-        let v = try_parse!(*value)?;
-        e = e.replace(Atom::from(symbol!(*name))).with(v);
+        e = e.replace(Atom::from(model_symbol(name))).with(atom(value)?);
     }
     Ok(e.to_string())
 }
@@ -49,6 +52,6 @@ pub fn substitute(expr: &str, subs: &[(&str, &str)]) -> Result<String, String> {
 /// `expr` typeset as LaTeX by symbolica's printer.
 pub fn latex(expr: &str) -> Result<String, String> {
     crate::lock::acquire()?;
-    let e = try_parse!(expr)?;
+    let e = atom(expr)?;
     Ok(format!("{}", e.printer(PrintOptions::latex())))
 }

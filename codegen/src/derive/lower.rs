@@ -11,10 +11,11 @@ use std::sync::Arc;
 
 use symbolica::prelude::*;
 
+use super::build::{constant_symbol, own_constants};
 use super::mechanics::Raw;
 use super::symbols::Symbols;
 use super::{Rat, is_zero};
-use crate::ir::FUNCTIONS;
+use crate::ir::Constant;
 
 /// A function application replaced by a symbol while matrices are computed.
 struct Lowered {
@@ -36,24 +37,34 @@ impl Lowering {
     /// symbol; sin and cos of the same argument are paired for the
     /// reduction.
     pub fn new(sym: &Symbols, raw: &Raw) -> Self {
+        let atoms: Vec<Atom> = raw.expressions().into_iter().map(own_constants).collect();
+        let mut base: Vec<Symbol> = sym
+            .params
+            .iter()
+            .chain(&sym.coords)
+            .chain(&sym.vels)
+            .copied()
+            .collect();
+        base.extend([Constant::Pi, Constant::E].map(constant_symbol));
+        Self::of(&atoms, base)
+    }
+
+    /// The lowering of `atoms`, whose rational functions have the variables
+    /// `base` and the lowered applications.
+    fn of(atoms: &[Atom], base: Vec<Symbol>) -> Self {
         let mut lowered: Vec<Lowered> = Vec::new();
         let mut seen: HashMap<String, usize> = HashMap::new();
         let mut args_by_fn: HashMap<String, (Option<Symbol>, Option<Symbol>)> = HashMap::new();
-        let atoms = raw.expressions();
-        for f in FUNCTIONS {
-            let Ok(pat) = try_parse!(format!("{f}(x__dalembert_arg_)").as_str()) else {
-                continue;
-            };
-            let pattern = pat.to_pattern();
-            for a in &atoms {
+        let wildcard = symbol!("x__dalembert_arg_");
+        for f in [Symbol::SIN, Symbol::COS, Symbol::EXP, Symbol::LOG] {
+            let pattern = function!(f, Atom::from(wildcard)).to_pattern();
+            for a in atoms {
                 let mut it = a.pattern_match(&pattern, None, None);
                 while let Some(found) = it.next_detailed() {
                     for (_, v) in found.match_stack {
                         let Match::Single(arg) = v else { continue };
                         let arg = arg.to_owned();
-                        let Ok(app) = try_parse!(format!("{f}({arg})").as_str()) else {
-                            continue;
-                        };
+                        let app = function!(f, arg.clone());
                         let key = app.to_string();
                         if seen.contains_key(&key) {
                             continue;
@@ -65,10 +76,10 @@ impl Lowering {
                             function: app,
                         });
                         let pair = args_by_fn.entry(arg.to_string()).or_default();
-                        match *f {
-                            "sin" => pair.0 = Some(s),
-                            "cos" => pair.1 = Some(s),
-                            _ => {}
+                        if f == Symbol::SIN {
+                            pair.0 = Some(s);
+                        } else if f == Symbol::COS {
+                            pair.1 = Some(s);
                         }
                     }
                 }
@@ -79,10 +90,7 @@ impl Lowering {
             .filter_map(|(s, c)| Some((s?, c?)))
             .collect();
         trig_pairs.sort_by_key(|(s, _)| s.to_string());
-        let mut vars: Vec<PolyVariable> = Vec::new();
-        for s in sym.params.iter().chain(&sym.coords).chain(&sym.vels) {
-            vars.push(PolyVariable::Symbol(*s));
-        }
+        let mut vars: Vec<PolyVariable> = base.into_iter().map(PolyVariable::Symbol).collect();
         for l in &lowered {
             vars.push(PolyVariable::Symbol(l.symbol));
         }
@@ -94,7 +102,7 @@ impl Lowering {
     }
 
     fn lower(&self, a: &Atom) -> Atom {
-        let mut a = a.clone();
+        let mut a = own_constants(a);
         for l in &self.lowered {
             a = a.replace(l.function.clone()).with(Atom::from(l.symbol));
         }
@@ -130,13 +138,9 @@ impl Lowering {
                 Match::Single(x) => x.to_owned() > Atom::num(1),
                 _ => false,
             }));
-            let Ok(lhs) = try_parse!(format!("{c}^n__dalembert_pow_").as_str()) else {
-                continue;
-            };
-            let Ok(rhs) = try_parse!(format!("{c}^(n__dalembert_pow_-2)*(1-{s}^2)").as_str())
-            else {
-                continue;
-            };
+            let lhs = Atom::from(*c).pow(Atom::from(n));
+            let rhs = Atom::from(*c).pow(Atom::from(n) - Atom::num(2))
+                * (Atom::num(1) - Atom::from(*s).pow(Atom::num(2)));
             for _ in 0..64 {
                 let next = a
                     .replace(lhs.clone())
@@ -189,4 +193,14 @@ impl Lowering {
             terms.join(" + ")
         }
     }
+}
+
+/// Whether `a` is zero as a rational function of its symbols and function
+/// applications, sin² + cos² = 1 reduced.
+pub fn vanishes(a: &Atom) -> bool {
+    let a = own_constants(a);
+    let low = Lowering::of(std::slice::from_ref(&a), Vec::new());
+    let r: Rat = low.lower(&a).to_rational_polynomial(&Q, &Z, None);
+    let numerator = low.reduce_trig(&r.numerator.to_expression());
+    is_zero(&numerator)
 }

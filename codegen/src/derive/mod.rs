@@ -15,6 +15,7 @@
 //! The result is plain data ([`Derivation`]); [`inspect`] has symbolic
 //! helpers for front ends and tests.
 
+mod build;
 mod checks;
 mod evaluate;
 pub mod inspect;

@@ -1,8 +1,11 @@
 //! Pass 1: the model's names as symbols, its definitions made free of each
-//! other, and its expressions parsed with every definition substituted.
+//! other, and its expressions built with every definition substituted.
+
+use std::collections::HashMap;
 
 use symbolica::prelude::*;
 
+pub use super::build::{build, model_symbol};
 use crate::diag::{Collector, ErrorKind, Reported};
 use crate::ir::{Expr, Model};
 
@@ -18,49 +21,37 @@ pub struct Symbols<'a> {
     /// One per velocity.
     pub vels: Vec<Symbol>,
     /// Each definition, free of the others.
-    definitions: Vec<(Symbol, Atom)>,
+    definitions: HashMap<String, Atom>,
 }
 
 impl<'a> Symbols<'a> {
-    /// The symbols of `model`; its definitions are parsed and substituted
-    /// into each other (the validator rejected cycles, so as many rounds as
-    /// there are definitions suffice).
+    /// The symbols of `model`; its definitions are built in the validator's
+    /// order (each refers only to earlier ones), so each is free of the
+    /// others by construction.
     pub fn new(model: &'a Model, cx: &mut Collector) -> Result<Self, Reported> {
         // Symbols are made in this order (parameters, coordinates,
         // velocities, then definitions) because symbolica orders terms, and
         // so the emitted instructions, by when their symbols were made.
-        let sym = |n: &String| symbol!(n.as_str());
-        let params = model.params.iter().map(|p| sym(&p.name)).collect();
-        let coords = model.coordinates.iter().map(sym).collect();
-        let vels = model.velocities.iter().map(sym).collect();
-        let mut defs = Vec::new();
+        let params: Vec<Symbol> = model.params.iter().map(|p| model_symbol(&p.name)).collect();
+        let coords: Vec<Symbol> = model.coordinates.iter().map(|n| model_symbol(n)).collect();
+        let vels: Vec<Symbol> = model.velocities.iter().map(|n| model_symbol(n)).collect();
+        let mut definitions = HashMap::new();
         for (name, e) in &model.definitions {
-            defs.push((symbol!(name.as_str()), parse_raw(e, cx)?));
-        }
-        for _ in 0..defs.len() {
-            let snapshot = defs.clone();
-            for (_, a) in defs.iter_mut() {
-                for (s, v) in &snapshot {
-                    *a = a.replace(Atom::from(*s)).with(v.clone());
-                }
-            }
+            let a = build_in(e, &definitions, cx)?;
+            definitions.insert(name.clone(), a);
         }
         Ok(Self {
             model,
             params,
             coords,
             vels,
-            definitions: defs,
+            definitions,
         })
     }
 
     /// The expression with every definition substituted.
     pub fn parse(&self, e: &Expr, cx: &mut Collector) -> Result<Atom, Reported> {
-        let mut a = parse_raw(e, cx)?;
-        for (s, v) in &self.definitions {
-            a = a.replace(Atom::from(*s)).with(v.clone());
-        }
-        Ok(a)
+        build_in(e, &self.definitions, cx)
     }
 
     /// Velocity k as an expression.
@@ -69,7 +60,8 @@ impl<'a> Symbols<'a> {
     }
 
     /// The inputs of every emitted function: parameters, coordinates,
-    /// velocities.
+    /// velocities (the constants π and e are not inputs; the evaluation
+    /// pass turns them into values).
     pub fn inputs(&self) -> Vec<Atom> {
         self.params
             .iter()
@@ -82,7 +74,7 @@ impl<'a> Symbols<'a> {
     /// The inputs at the sample point: the file's parameter values,
     /// [`sample_configuration`], zero velocities.
     pub fn sample_inputs(&self) -> Vec<f64> {
-        let mut v: Vec<f64> = self.model.params.iter().map(|p| p.value.to_f64()).collect();
+        let mut v: Vec<f64> = self.model.params.iter().map(|p| p.value).collect();
         v.extend(sample_configuration(self.coords.len()));
         v.extend(std::iter::repeat_n(0.0, self.vels.len()));
         v
@@ -103,7 +95,7 @@ impl<'a> Symbols<'a> {
             .model
             .params
             .iter()
-            .map(|p| format!("{} = {}", p.name, p.value));
+            .map(|p| format!("{} = {}", p.name, p.written));
         let coords = self
             .model
             .coordinates
@@ -114,12 +106,15 @@ impl<'a> Symbols<'a> {
     }
 }
 
-/// Parses one expression of the model file.
-fn parse_raw(e: &Expr, cx: &mut Collector) -> Result<Atom, Reported> {
-    try_parse!(e.text.as_str()).map_err(|msg| {
-        let first = msg.lines().next().unwrap_or("").to_string();
-        cx.error(ErrorKind::Syntax(first), Some(e.span.clone()))
-    })
+/// `e` as an expression, each name either a definition in `definitions` or
+/// a model symbol; what cannot be built is reported at its place.
+fn build_in(
+    e: &Expr,
+    definitions: &HashMap<String, Atom>,
+    cx: &mut Collector,
+) -> Result<Atom, Reported> {
+    build(&e.node, definitions)
+        .map_err(|b| cx.error(ErrorKind::Domain(b.message), Some(e.at(&b.span))))
 }
 
 /// Where G is checked for positive definiteness: qᵢ = 0.3 + 0.41·i

@@ -73,7 +73,11 @@ fn sincos_pairs(p: &Program) -> Vec<Option<(usize, bool)>> {
     let mut calls: HashMap<(Slot, usize), (Option<usize>, Option<usize>)> = HashMap::new();
     for (i, ins) in p.instrs.iter().enumerate() {
         let dst = match ins {
-            Instr::Add(o, _) | Instr::Mul(o, _) | Instr::Pow(o, _, _) | Instr::Assign(o, _) => *o,
+            Instr::Add(o, _)
+            | Instr::Mul(o, _)
+            | Instr::Pow(o, _, _)
+            | Instr::Powf(o, _, _)
+            | Instr::Assign(o, _) => *o,
             Instr::Fun(o, f, src) => {
                 let value = (*src, writes.get(src).copied().unwrap_or(0));
                 let entry = calls.entry(value).or_default();
@@ -125,7 +129,9 @@ fn sincos(
 fn sources(ins: &Instr) -> Vec<Slot> {
     match ins {
         Instr::Add(_, s) | Instr::Mul(_, s) => s.clone(),
-        Instr::Pow(_, s, _) | Instr::Fun(_, _, s) | Instr::Assign(_, s) => vec![*s],
+        Instr::Pow(_, s, _) | Instr::Powf(_, s, _) | Instr::Fun(_, _, s) | Instr::Assign(_, s) => {
+            vec![*s]
+        }
     }
 }
 
@@ -164,6 +170,7 @@ fn instr(d: &Ctx, p: &Program, ins: &Instr) -> TokenStream {
         Instr::Add(o, s) => (*o, join(s.iter().map(|&x| slot(d, p, x)), quote! { + })),
         Instr::Mul(o, s) => (*o, product(d, p, s)),
         Instr::Pow(o, s, n) => (*o, pow(d, slot(d, p, *s), *n)),
+        Instr::Powf(o, s, x) => (*o, powf(d, slot(d, p, *s), *x)),
         Instr::Fun(o, f, s) => {
             let f = libm_fn(d, f.name());
             let s = slot(d, p, *s);
@@ -224,6 +231,21 @@ fn pow(d: &Ctx, x: TokenStream, n: i64) -> TokenStream {
         quote! { 1.0 / #positive }
     } else {
         positive
+    }
+}
+
+/// x^e for a fractional constant e: a square root for ±½ (as
+/// [`crate::program::powf`] evaluates it), libm's pow otherwise.
+fn powf(d: &Ctx, x: TokenStream, e: f64) -> TokenStream {
+    let sqrt = libm_fn(d, "sqrt");
+    if e == 0.5 {
+        quote! { #sqrt(#x) }
+    } else if e == -0.5 {
+        quote! { 1.0 / #sqrt(#x) }
+    } else {
+        let f = libm_fn(d, "pow");
+        let e = lit(d, e);
+        quote! { #f(#x, #e) }
     }
 }
 

@@ -139,14 +139,9 @@ fn params_struct(d: &Ctx) -> TokenStream {
         .model
         .params
         .iter()
-        .map(|p| doc_attr(&format!("{} (model file: {})", p.doc, p.value)))
+        .map(|p| doc_attr(&format!("{} (model file: {})", p.doc, p.written)))
         .collect();
-    let values: Vec<Literal> = d
-        .model
-        .params
-        .iter()
-        .map(|p| lit(d, p.value.to_f64()))
-        .collect();
+    let values: Vec<Literal> = d.model.params.iter().map(|p| lit(d, p.value)).collect();
     let model = &d.model.name;
     let real = real(d);
     let sdoc = format!(" Parameters of `{model}`; `Default` gives the model file's values.");

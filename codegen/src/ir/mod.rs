@@ -5,8 +5,8 @@
 //! an undeclared name or a malformed expression. This stage does not use the
 //! symbolic engine at all.
 
+pub mod expr;
 mod file;
-mod lex;
 mod names;
 mod number;
 mod validate;
@@ -17,11 +17,9 @@ use std::path::Path;
 
 use crate::diag::{Collector, ErrorKind, ModelErrors};
 use file::File;
-use lex::{Token, content_start, tokens};
 use validate::Validator;
 
-/// Functions a model's expressions may call.
-pub const FUNCTIONS: &[&str] = &["sin", "cos", "tan", "exp", "log", "sqrt"];
+pub use expr::{Constant, Function, Node, NodeKind};
 
 /// Names models may not declare: functions, constants and names the
 /// generated code uses itself.
@@ -32,11 +30,59 @@ pub(crate) const RESERVED: &[&str] = &[
 
 /// Rust keywords (strict and reserved, 2024 edition): not usable as names.
 pub(crate) const RUST_KEYWORDS: &[&str] = &[
-    "as", "async", "await", "break", "const", "continue", "crate", "dyn", "else", "enum", "extern",
-    "false", "fn", "for", "gen", "if", "impl", "in", "let", "loop", "match", "mod", "move", "mut",
-    "pub", "ref", "return", "static", "struct", "super", "trait", "true", "type", "unsafe", "use",
-    "where", "while", "abstract", "become", "box", "do", "final", "macro", "override", "priv",
-    "try", "typeof", "unsized", "virtual", "yield",
+    "self", "Self", "union", "as", "async", "await", "break", "const", "continue", "crate", "dyn",
+    "else", "enum", "extern", "false", "fn", "for", "gen", "if", "impl", "in", "let", "loop",
+    "match", "mod", "move", "mut", "pub", "ref", "return", "static", "struct", "super", "trait",
+    "true", "type", "unsafe", "use", "where", "while", "abstract", "become", "box", "do", "final",
+    "macro", "override", "priv", "try", "typeof", "unsized", "virtual", "yield",
+];
+
+/// Type names a generated file uses or defines besides the model's own: the
+/// model's type (its name in CamelCase) may not be one of them.
+pub(crate) const GENERATED_TYPE_NAMES: &[&str] = &[
+    "Params",
+    "Wall",
+    "Self",
+    "Default",
+    "Clone",
+    "Copy",
+    "Debug",
+    "PartialEq",
+    "Eq",
+    "Hash",
+    "Option",
+    "Some",
+    "None",
+    "Result",
+    "Ok",
+    "Err",
+    "Sized",
+    "Send",
+    "Sync",
+    "Unpin",
+    "Drop",
+    "Fn",
+    "FnMut",
+    "FnOnce",
+    "Box",
+    "String",
+    "Vec",
+    "ToString",
+    "ToOwned",
+    "Iterator",
+    "IntoIterator",
+    "DoubleEndedIterator",
+    "ExactSizeIterator",
+    "Extend",
+    "FromIterator",
+    "Into",
+    "From",
+    "TryInto",
+    "TryFrom",
+    "AsRef",
+    "AsMut",
+    "Ord",
+    "PartialOrd",
 ];
 
 /// An exact rational number p/q with q > 0.
@@ -72,15 +118,34 @@ pub struct Expr {
     pub text: String,
     /// Byte range of the string in the file.
     pub span: Range<usize>,
+    /// Byte offset in the file of the text's first character, when the
+    /// file holds the text verbatim (no escapes).
+    pub base: Option<usize>,
+    /// The parsed expression (spans relative to `text`).
+    pub node: Node,
 }
 
-/// A declared parameter.
+impl Expr {
+    /// The file's byte range of `r`, a range in the expression's text (the
+    /// whole string when the text is not verbatim in the file).
+    pub fn at(&self, r: &Range<usize>) -> Range<usize> {
+        match self.base {
+            Some(b) => b + r.start..b + r.end.max(r.start + 1).min(self.text.len().max(1)),
+            None => self.span.clone(),
+        }
+    }
+}
+
+/// A declared parameter (one with a value of its own; derived parameters
+/// are definitions).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Param {
     /// Its name.
     pub name: String,
     /// The file's value.
-    pub value: Rational,
+    pub value: f64,
+    /// The value as the file writes it (`1/2`, `pi/6`).
+    pub written: String,
     /// Its doc text.
     pub doc: String,
 }
@@ -132,15 +197,19 @@ pub struct Model {
     pub name: String,
     /// Doc text.
     pub doc: String,
-    /// Parameters in file order.
+    /// Parameters in file order (those with values of their own).
     pub params: Vec<Param>,
+    /// Derived parameters: values computed from other parameters, among
+    /// the definitions (first there).
+    pub derived: Vec<String>,
     /// Kind of model.
     pub kind: Kind,
     /// Coordinate names (empty for instantaneous models).
     pub coordinates: Vec<String>,
     /// Velocity names.
     pub velocities: Vec<String>,
-    /// Definitions, in file order, each already free of other definitions.
+    /// Derived parameters, then definitions, ordered so that each uses only
+    /// earlier ones.
     pub definitions: Vec<(String, Expr)>,
     /// T.
     pub kinetic_energy: Expr,
@@ -215,6 +284,7 @@ pub fn parse(path: &Path, text: &str) -> Result<Model, ModelErrors> {
     .model(path, file);
     if let Some(m) = &model {
         check_names(m, &mut cx);
+        check_degrees(m, &mut cx);
     }
     match model {
         Some(m) => cx.finish(m),
@@ -233,19 +303,38 @@ fn check_names(model: &Model, cx: &mut Collector) {
         .chain(model.definitions.iter().map(|(n, _)| n.as_str()))
         .collect();
     for e in model.expressions() {
-        let base = content_start(&model.source, e);
-        for tok in tokens(&e.text) {
-            if let Token::Name(n, r) = tok
-                && !declared.contains(n)
-            {
+        e.node.visit_names(&mut |n, r| {
+            if !declared.contains(n) {
                 cx.error(
                     ErrorKind::UnknownName {
                         name: n.to_string(),
                     },
-                    base.map(|b| b + r.start..b + r.end)
-                        .or(Some(e.span.clone())),
+                    Some(e.at(r)),
                 );
             }
+        });
+    }
+}
+
+/// Reports every expression whose polynomial degree, definitions
+/// substituted, exceeds [`expr::MAX_DEGREE`].
+fn check_degrees(model: &Model, cx: &mut Collector) {
+    let mut degree: HashMap<&str, u64> = HashMap::new();
+    for (name, e) in &model.definitions {
+        let d = e.node.degree(&|n| degree.get(n).copied().unwrap_or(1));
+        degree.insert(name, d);
+    }
+    let definitions = model.definitions.len();
+    for e in model.expressions().skip(definitions) {
+        let d = e.node.degree(&|n| degree.get(n).copied().unwrap_or(1));
+        if d > expr::MAX_DEGREE {
+            cx.error(
+                ErrorKind::Limit(format!(
+                    "the expression reaches polynomial degree {d}; the limit is {}",
+                    expr::MAX_DEGREE
+                )),
+                Some(e.span.clone()),
+            );
         }
     }
 }

@@ -1,14 +1,14 @@
 //! Names and expressions of the model file: each declared name checked and
-//! recorded, each expression's tokens checked (unknown names are checked
-//! once every declaration is known).
+//! recorded, each expression parsed (unknown names are checked once every
+//! declaration is known).
 
 use std::ops::Range;
 
 use toml::Spanned;
 
-use super::lex::{Token, content_start, tokens};
+use super::expr::{Node, NodeKind, parse};
 use super::validate::Validator;
-use super::{Expr, FUNCTIONS, RESERVED, RUST_KEYWORDS};
+use super::{Expr, RESERVED, RUST_KEYWORDS, Rational};
 use crate::diag::ErrorKind;
 
 impl Validator<'_> {
@@ -57,64 +57,55 @@ impl Validator<'_> {
         }
     }
 
-    /// Checks an expression's tokens; unknown names are checked later, once
-    /// every declaration is known ([`check_names`]).
+    /// Parses an expression; what is malformed is reported at its place.
+    /// Unknown names are checked later, once every declaration is known
+    /// ([`check_names`](super::check_names)).
     pub(super) fn expr(&mut self, s: &Spanned<String>) -> Expr {
-        let expr = Expr {
-            text: s.get_ref().clone(),
-            span: s.span(),
-        };
-        let base = content_start(self.text, &expr);
-        let mut depth: i64 = 0;
-        let mut empty = true;
-        for tok in tokens(&expr.text) {
-            empty = false;
-            let at = |r: &Range<usize>| base.map(|b| b + r.start..b + r.end).or(Some(s.span()));
-            match tok {
-                Token::Bad(c, r) => {
-                    self.cx.error(
-                        ErrorKind::Syntax(format!("unexpected character `{c}`")),
-                        at(&r),
-                    );
+        let text = s.get_ref().clone();
+        let base = content_start(self.text, &text, s.span());
+        let node = match parse(&text) {
+            Ok(node) => node,
+            Err(e) => {
+                let kind = if e.limit {
+                    ErrorKind::Limit(e.message)
+                } else {
+                    ErrorKind::Syntax(e.message)
+                };
+                let at = base.map(|b| b + e.span.start..b + e.span.end.max(e.span.start + 1));
+                self.cx.error(kind, at.or(Some(s.span())));
+                Node {
+                    kind: NodeKind::Number(Rational { num: 0, den: 1 }),
+                    span: 0..0,
                 }
-                Token::Decimal(t, r) => {
-                    self.cx.error(
-                        ErrorKind::Syntax(format!(
-                            "`{t}` is a decimal number; models are exact: write it as a fraction"
-                        )),
-                        at(&r),
-                    );
-                }
-                Token::Open => depth += 1,
-                Token::Close(r) => {
-                    depth -= 1;
-                    if depth < 0 {
-                        self.cx
-                            .error(ErrorKind::Syntax("unmatched `)`".into()), at(&r));
-                        depth = 0;
-                    }
-                }
-                Token::Call(n, r) if !FUNCTIONS.contains(&n) => {
-                    self.cx.error(
-                        ErrorKind::UnknownFunction {
-                            name: n.to_string(),
-                        },
-                        at(&r),
-                    );
-                }
-                _ => {}
             }
+        };
+        Expr {
+            text,
+            span: s.span(),
+            base,
+            node,
         }
-        if empty {
-            self.cx.error(
-                ErrorKind::Syntax("the expression is empty".into()),
-                Some(s.span()),
-            );
-        }
-        if depth > 0 {
-            self.cx
-                .error(ErrorKind::Syntax("unclosed `(`".into()), Some(s.span()));
-        }
-        expr
     }
+}
+
+/// Byte offset in the file of the first character of the string's content,
+/// when the file's text of the string is its value verbatim (no escapes).
+fn content_start(file: &str, text: &str, span: Range<usize>) -> Option<usize> {
+    let raw = file.get(span.clone())?;
+    let (open, rest) = if raw.starts_with("\"\"\"") || raw.starts_with("'''") {
+        let rest = &raw[3..];
+        let skip = if rest.starts_with("\r\n") {
+            2
+        } else if rest.starts_with('\n') {
+            1
+        } else {
+            0
+        };
+        (3 + skip, &rest[skip..])
+    } else if raw.starts_with('"') || raw.starts_with('\'') {
+        (1, &raw[1..])
+    } else {
+        return None;
+    };
+    rest.starts_with(text).then_some(span.start + open)
 }

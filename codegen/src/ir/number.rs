@@ -5,43 +5,9 @@ use super::file::Number;
 
 /// An exact rational from a TOML value: an integer, a string "p/q", an
 /// integer string, or a decimal (as a string or a TOML float), read exactly.
-/// An initial value: an exact number, or one times `pi` (`pi/2`, `-3*pi/4`).
-pub(super) fn initial_value(n: &Number) -> Result<f64, String> {
-    let Number::Text(t) = n else {
-        return rational(n).map(Rational::to_f64);
-    };
-    let t: String = t.chars().filter(|c| !c.is_whitespace()).collect();
-    let Some((before, after)) = t.split_once("pi") else {
-        return rational(n).map(Rational::to_f64);
-    };
-    let coefficient = match before.strip_suffix('*').unwrap_or(before) {
-        "" => 1.0,
-        "-" => -1.0,
-        c => rational(&Number::Text(c.to_string()))?.to_f64(),
-    };
-    let divisor = match after.strip_prefix('/') {
-        None if after.is_empty() => 1.0,
-        Some(d) => rational(&Number::Text(d.to_string()))?.to_f64(),
-        None => {
-            return Err(format!(
-                "`{t}`: write a rational multiple of pi such as `pi/2` or `-3*pi/4`"
-            ));
-        }
-    };
-    if divisor == 0.0 {
-        return Err(format!("`{t}` divides by zero"));
-    }
-    Ok(coefficient * std::f64::consts::PI / divisor)
-}
-
 pub(super) fn rational(n: &Number) -> Result<Rational, String> {
     let text = match n {
-        Number::Int(i) => {
-            return Ok(Rational {
-                num: *i as i128,
-                den: 1,
-            });
-        }
+        Number::Int(i) => return bounded(*i as i128, 1).ok_or_else(|| format!("{i} is too large")),
         Number::Float(f) if !f.is_finite() => {
             return Err(format!("{f} is not a finite number"));
         }
@@ -49,51 +15,145 @@ pub(super) fn rational(n: &Number) -> Result<Rational, String> {
         Number::Float(f) => format!("{f}"),
         Number::Text(t) => t.trim().to_string(),
     };
-    let parse_int = |s: &str| -> Result<i128, String> {
-        s.trim().parse::<i128>().map_err(|_| {
+    match text.split_once('/') {
+        Some((p, q)) => {
+            let p = signed_decimal(p.trim())?;
+            let q = signed_decimal(q.trim())?;
+            if q.num == 0 {
+                return Err(format!("`{text}` divides by zero"));
+            }
+            checked_div(p, q).ok_or_else(|| format!("`{text}` is too large"))
+        }
+        None => signed_decimal(&text),
+    }
+    .map_err(|why| {
+        if why.contains("too large") {
+            why
+        } else {
             format!(
                 "`{text}` is not an exact number (write an integer, a fraction p/q or a decimal)"
             )
-        })
-    };
-    let (num, den) = if let Some((p, q)) = text.split_once('/') {
-        (parse_int(p)?, parse_int(q)?)
-    } else if let Some((whole, frac)) = text.split_once('.') {
-        if frac.is_empty() || !frac.chars().all(|c| c.is_ascii_digit()) || frac.len() > 18 {
-            return Err(format!("`{text}` is not an exact decimal"));
         }
-        let den = 10i128.pow(frac.len() as u32);
-        let negative = whole.trim().starts_with('-');
-        let w = if whole.trim() == "-" || whole.trim().is_empty() {
-            0
-        } else {
-            parse_int(whole)?
-        };
-        let f = parse_int(frac)?;
-        let num = w
-            .checked_mul(den)
-            .and_then(|x| {
-                if negative {
-                    x.checked_sub(f)
-                } else {
-                    x.checked_add(f)
-                }
-            })
-            .ok_or_else(|| format!("`{text}` is too large"))?;
-        (num, den)
-    } else {
-        (parse_int(&text)?, 1)
+    })
+}
+
+/// An optionally signed decimal number.
+fn signed_decimal(t: &str) -> Result<Rational, String> {
+    match t.strip_prefix('-') {
+        Some(rest) => decimal(rest.trim()).map(|r| Rational {
+            num: -r.num,
+            den: r.den,
+        }),
+        None => decimal(t.strip_prefix('+').unwrap_or(t).trim()),
+    }
+}
+
+/// Largest numerator or denominator of an exact number: far inside i128, so
+/// that products of two never overflow before they are checked.
+const MAX_PART: i128 = 1 << 60;
+
+/// An unsigned decimal literal, exactly: `12`, `0.25`, `.5`, `1e-3`,
+/// `2.5E4`.
+pub(super) fn decimal(t: &str) -> Result<Rational, String> {
+    let bad = || format!("`{t}` is not a number");
+    let (mantissa, exponent) = match t.find(['e', 'E']) {
+        Some(i) => (&t[..i], Some(&t[i + 1..])),
+        None => (t, None),
     };
-    if den == 0 {
-        return Err(format!("`{text}` divides by zero"));
+    let (whole, frac) = mantissa.split_once('.').unwrap_or((mantissa, ""));
+    if whole.is_empty() && frac.is_empty()
+        || !whole
+            .bytes()
+            .chain(frac.bytes())
+            .all(|c| c.is_ascii_digit())
+    {
+        return Err(bad());
+    }
+    let digits = format!("{whole}{frac}");
+    let digits = digits.trim_start_matches('0');
+    if digits.len() > 18 {
+        return Err(format!(
+            "`{t}` is too large or too precise (at most 18 digits)"
+        ));
+    }
+    let mut power: i64 = -(frac.len() as i64);
+    if let Some(e) = exponent {
+        let e: i64 = e.parse().map_err(|_| bad())?;
+        if e.abs() > 18 {
+            return Err(format!(
+                "`{t}` is too large or too small (exponents up to 18)"
+            ));
+        }
+        power += e;
+    }
+    let n: i128 = if digits.is_empty() {
+        0
+    } else {
+        digits.parse().map_err(|_| bad())?
+    };
+    let scale = 10i128.pow(power.unsigned_abs() as u32);
+    let r = if power >= 0 {
+        bounded(n * scale, 1)
+    } else {
+        bounded(n, scale)
+    };
+    r.ok_or_else(|| format!("`{t}` is too large (at most about 1e18)"))
+}
+
+/// p/q in lowest terms with q > 0, when both fit the bounds.
+fn bounded(num: i128, den: i128) -> Option<Rational> {
+    if den == 0
+        || num.checked_abs()? > MAX_PART * MAX_PART
+        || den.checked_abs()? > MAX_PART * MAX_PART
+    {
+        return None;
     }
     let g = gcd(num.unsigned_abs(), den.unsigned_abs()) as i128;
     let (num, den) = (num / g, den / g);
     let (num, den) = if den < 0 { (-num, -den) } else { (num, den) };
-    if num.unsigned_abs() > 1u128 << 60 || den > 1i128 << 60 {
-        return Err(format!("`{text}` has a numerator or denominator too large"));
+    (num.abs() <= MAX_PART && den <= MAX_PART).then_some(Rational { num, den })
+}
+
+/// a + b, if it fits.
+pub(super) fn checked_add(a: Rational, b: Rational) -> Option<Rational> {
+    let num = a
+        .num
+        .checked_mul(b.den)?
+        .checked_add(b.num.checked_mul(a.den)?)?;
+    bounded(num, a.den.checked_mul(b.den)?)
+}
+
+/// a · b, if it fits.
+pub(super) fn checked_mul(a: Rational, b: Rational) -> Option<Rational> {
+    bounded(a.num.checked_mul(b.num)?, a.den.checked_mul(b.den)?)
+}
+
+/// a / b, if b ≠ 0 and it fits.
+pub(super) fn checked_div(a: Rational, b: Rational) -> Option<Rational> {
+    bounded(a.num.checked_mul(b.den)?, a.den.checked_mul(b.num)?)
+}
+
+/// aⁿ, if it fits (a ≠ 0 when n < 0).
+pub(super) fn checked_pow(a: Rational, n: i128) -> Option<Rational> {
+    let k = n.unsigned_abs();
+    let out = if a.num.abs() == a.den || a.num == 0 {
+        // ±1 and 0: any power, by parity.
+        let negative = a.num < 0 && k % 2 == 1;
+        let unit = if a.num == 0 && k > 0 { 0 } else { 1 };
+        Rational {
+            num: if negative { -unit } else { unit },
+            den: 1,
+        }
+    } else if k > 128 {
+        return None;
+    } else {
+        (0..k).try_fold(Rational { num: 1, den: 1 }, |acc, _| checked_mul(acc, a))?
+    };
+    if n < 0 {
+        checked_div(Rational { num: 1, den: 1 }, out)
+    } else {
+        Some(out)
     }
-    Ok(Rational { num, den })
 }
 
 fn gcd(mut a: u128, mut b: u128) -> u128 {

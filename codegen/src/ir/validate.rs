@@ -1,16 +1,16 @@
 //! The validator: one method per part of the model file, each recording
 //! what is wrong with its file:line:col and going on.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::HashMap;
 use std::path::Path;
 
 use indexmap::IndexMap;
 use toml::Spanned;
 
+use super::expr::MAX_DEGREE;
 use super::file::{File, Names, Number, ParamDecl, WallDecl};
-use super::lex::{Token, tokens};
-use super::number::{initial_value, rational};
-use super::{Expr, Kind, Model, Param, ProjectorMode, Rational, Wall};
+use super::number::rational;
+use super::{Expr, GENERATED_TYPE_NAMES, Kind, Model, Param, ProjectorMode, Wall, camel};
 use crate::diag::{Collector, ErrorKind};
 
 pub(super) struct Validator<'a> {
@@ -33,13 +33,33 @@ impl Validator<'_> {
                 },
                 Some(header.name.span()),
             );
+        } else if GENERATED_TYPE_NAMES.contains(&camel(&name).as_str()) {
+            self.cx.error(
+                ErrorKind::BadName {
+                    name: name.clone(),
+                    why: format!(
+                        "the model's type would be `{}`, a name the generated code already uses",
+                        camel(&name)
+                    ),
+                },
+                Some(header.name.span()),
+            );
         }
 
         let projector = self.projector_mode(header.projector.as_ref());
-        let params = self.params(&file.parameters);
+        let (params, derived) = self.params(&file.parameters);
         let (kind, coordinates, velocities) =
             self.variables(file.coordinates.as_ref(), file.velocities.as_ref());
-        let definitions = self.definitions(&file.definitions);
+        for name in file.definitions.keys() {
+            self.declare(name, "definition");
+        }
+        let derived_names: Vec<String> = derived.iter().map(|(n, _)| n.get_ref().clone()).collect();
+        self.only_parameters(&params, &derived);
+        let mut all: Vec<(Spanned<String>, Expr)> = derived;
+        for (n, e) in &file.definitions {
+            all.push((n.clone(), self.expr(e)));
+        }
+        let definitions = self.definitions(all);
 
         let dyn_span = file.dynamics.span();
         let dynamics = file.dynamics.into_inner();
@@ -67,10 +87,14 @@ impl Validator<'_> {
                 Some(dyn_span),
             );
         }
+        let state_len = coordinates.len() + velocities.len();
+        let initial =
+            self.initial_values(&params, &derived_names, &definitions, initial, state_len);
         Some(Model {
             name,
             doc: header.doc.trim().to_string(),
             params,
+            derived: derived_names,
             kind,
             coordinates,
             velocities,
@@ -87,40 +111,71 @@ impl Validator<'_> {
         })
     }
 
-    fn params(&mut self, decls: &IndexMap<Spanned<String>, Spanned<ParamDecl>>) -> Vec<Param> {
+    /// Parameters: an exact number, a constant expression (`pi/6`), or an
+    /// expression of other parameters (`2/5*m*r^2`), which makes it a
+    /// derived parameter: returned apart, to be substituted like a
+    /// definition, so that it follows the others wherever they change.
+    fn params(
+        &mut self,
+        decls: &IndexMap<Spanned<String>, Spanned<ParamDecl>>,
+    ) -> (Vec<Param>, Vec<(Spanned<String>, Expr)>) {
         let mut out = Vec::new();
+        let mut derived = Vec::new();
         for (name, decl) in decls {
             self.declare(name, "parameter");
-            let (value, span, doc) = match decl.get_ref() {
-                ParamDecl::Full { value, doc } => (value.as_ref(), decl.span(), doc.clone()),
-                ParamDecl::Bare(v) => (Some(v), decl.span(), String::new()),
+            let (value, doc) = match decl.get_ref() {
+                ParamDecl::Full { value, doc } => (value.as_ref(), doc.clone()),
+                ParamDecl::Bare(v) => (Some(v), String::new()),
             };
-            let value = value.ok_or_else(|| "it has no value: write `value = \"…\"`".to_string());
-            match value.and_then(rational) {
-                Ok(value) => out.push(Param {
-                    name: name.get_ref().clone(),
-                    value,
-                    doc,
-                }),
-                Err(why) => {
+            let param = |value: f64, written: String| Param {
+                name: name.get_ref().clone(),
+                value,
+                written,
+                doc: doc.clone(),
+            };
+            let exact = value
+                .ok_or_else(|| "it has no value: write `value = \"…\"`".to_string())
+                .and_then(rational);
+            match (exact, value) {
+                (Ok(r), _) => out.push(param(r.to_f64(), r.to_string())),
+                (Err(_), Some(Number::Text(text))) => {
+                    let spanned = Spanned::new(decl.span(), text.clone());
+                    let e = self.expr(&spanned);
+                    let mut uses_names = false;
+                    e.node.visit_names(&mut |_, _| uses_names = true);
+                    if uses_names {
+                        derived.push((name.clone(), e));
+                    } else {
+                        match e.node.value(&|_| None) {
+                            Some(v) if v.is_finite() => out.push(param(v, text.trim().to_string())),
+                            _ => {
+                                self.cx.error(
+                                    ErrorKind::BadParameter {
+                                        name: name.get_ref().clone(),
+                                        why: format!("`{text}` has no finite real value"),
+                                    },
+                                    Some(decl.span()),
+                                );
+                                out.push(param(0.0, text.clone()));
+                            }
+                        }
+                    }
+                }
+                (Err(why), _) => {
                     self.cx.error(
                         ErrorKind::BadParameter {
                             name: name.get_ref().clone(),
                             why,
                         },
-                        Some(span),
+                        Some(decl.span()),
                     );
                     // Still declared, so its uses are not reported as unknown;
                     // the model is rejected anyway.
-                    out.push(Param {
-                        name: name.get_ref().clone(),
-                        value: Rational { num: 0, den: 1 },
-                        doc,
-                    });
+                    out.push(param(0.0, String::new()));
                 }
             }
         }
-        out
+        (out, derived)
     }
 
     fn variables(
@@ -249,74 +304,104 @@ impl Validator<'_> {
         (Kind::Instantaneous, Vec::new(), names)
     }
 
-    /// Definitions, each rewritten free of other definitions.
-    fn definitions(
-        &mut self,
-        decls: &IndexMap<Spanned<String>, Spanned<String>>,
-    ) -> Vec<(String, Expr)> {
-        for name in decls.keys() {
-            self.declare(name, "definition");
+    /// Definitions, ordered so that each refers only to earlier ones; cycles
+    /// are reported, and so is a definition that would expand past the
+    /// limits once the ones it uses are substituted.
+    fn definitions(&mut self, decls: Vec<(Spanned<String>, Expr)>) -> Vec<(String, Expr)> {
+        if decls.len() > MAX_DEFINITIONS {
+            self.cx.error(
+                ErrorKind::Limit(format!(
+                    "{} definitions; the limit is {MAX_DEFINITIONS}",
+                    decls.len()
+                )),
+                decls.get(MAX_DEFINITIONS).map(|(n, _)| n.span()),
+            );
+            return Vec::new();
         }
-        let raw: BTreeMap<String, Expr> = decls
+        let (names, exprs): (Vec<Spanned<String>>, Vec<Expr>) = decls.into_iter().unzip();
+        let index: HashMap<&str, usize> = names
             .iter()
-            .map(|(n, e)| (n.get_ref().clone(), self.expr(e)))
+            .enumerate()
+            .map(|(i, n)| (n.get_ref().as_str(), i))
             .collect();
-        // Cycle check by depth-first search over references.
-        let mut out = Vec::new();
-        for name in decls.keys() {
-            let mut stack = vec![name.get_ref().clone()];
-            if self.refers_to_itself(&raw, &mut stack) {
+        let uses: Vec<Vec<usize>> = exprs
+            .iter()
+            .map(|e| {
+                let mut u = Vec::new();
+                e.node.visit_names(&mut |n, _| u.extend(index.get(n)));
+                u.sort_unstable();
+                u.dedup();
+                u
+            })
+            .collect();
+        for (i, name) in names.iter().enumerate() {
+            if reaches(&uses, i) {
                 self.cx
                     .error(ErrorKind::Cycle(name.get_ref().clone()), Some(name.span()));
             }
-            out.push((name.get_ref().clone(), raw[name.get_ref()].clone()));
         }
-        out
-    }
-
-    fn refers_to_itself(&self, defs: &BTreeMap<String, Expr>, stack: &mut Vec<String>) -> bool {
-        let Some(last) = stack.last() else {
-            return false;
-        };
-        let Some(expr) = defs.get(last) else {
-            return false;
-        };
-        for tok in tokens(&expr.text) {
-            if let Token::Name(n, _) = tok
-                && defs.contains_key(n)
-            {
-                if n == stack[0] {
-                    return true;
-                }
-                if stack.iter().any(|s| s == n) {
-                    continue;
-                }
-                stack.push(n.to_string());
-                let found = self.refers_to_itself(defs, stack);
-                stack.pop();
-                if found {
-                    return true;
-                }
+        let order = dependency_order(&uses);
+        let (mut size, mut degree) = (vec![1u64; exprs.len()], vec![1u64; exprs.len()]);
+        for &i in &order {
+            let lookup = |table: &[u64], n: &str| index.get(n).map_or(1, |&j| table[j]);
+            size[i] = exprs[i].node.size(&|n| lookup(&size, n));
+            degree[i] = exprs[i].node.degree(&|n| lookup(&degree, n));
+            let over = if size[i] > MAX_EXPANDED_SIZE {
+                Some(format!(
+                    "definition `{}` expands to more than {MAX_EXPANDED_SIZE} terms once the definitions it uses are substituted",
+                    names[i].get_ref()
+                ))
+            } else if degree[i] > MAX_DEGREE {
+                Some(format!(
+                    "definition `{}` reaches degree {} (the limit is {MAX_DEGREE})",
+                    names[i].get_ref(),
+                    degree[i]
+                ))
+            } else {
+                None
+            };
+            if let Some(why) = over {
+                self.cx.error(ErrorKind::Limit(why), Some(names[i].span()));
             }
         }
-        false
+        order
+            .into_iter()
+            .map(|i| (names[i].get_ref().clone(), exprs[i].clone()))
+            .collect()
     }
 
     fn walls(&mut self, kind: Kind, decls: &[Spanned<WallDecl>]) -> Vec<Wall> {
         let mut out = Vec::new();
-        let mut seen: HashMap<String, ()> = HashMap::new();
+        // Walls by their variant in the generated `Wall` enum.
+        let mut variants: HashMap<String, String> = HashMap::new();
         for decl in decls {
             let w = decl.get_ref();
             let name = w.name.get_ref().clone();
             self.check_ident(&name, w.name.span(), false);
-            if seen.insert(name.clone(), ()).is_some() {
+            if name.chars().any(|c| c.is_ascii_uppercase()) {
                 self.cx.error(
-                    ErrorKind::Duplicate {
+                    ErrorKind::BadName {
                         name: name.clone(),
-                        first: "wall",
+                        why: "a wall's name is snake_case (lower case, digits and `_`)".into(),
                     },
                     Some(w.name.span()),
                 );
+            } else if let Some(first) = variants.insert(camel(&name), name.clone()) {
+                let kind = if first == name {
+                    ErrorKind::Duplicate {
+                        name: name.clone(),
+                        first: "wall",
+                    }
+                } else {
+                    ErrorKind::BadName {
+                        name: name.clone(),
+                        why: format!(
+                            "it and wall `{first}` would both be `Wall::{}` in the generated code",
+                            camel(&name)
+                        ),
+                    }
+                };
+                self.cx.error(kind, Some(w.name.span()));
             }
             match (kind, &w.surface, &w.normal_velocity) {
                 (Kind::Coordinates, None, _) => {
@@ -365,15 +450,15 @@ impl Validator<'_> {
         out
     }
 
-    /// The `[initial]` table: values for coordinates and velocities, exact
-    /// numbers or rational multiples of `pi`.
+    /// The `[initial]` table: for each coordinate and velocity it names,
+    /// an expression of the parameters (`pi/2`, `r + 1`).
     fn initial(
         &mut self,
         coordinates: &[String],
         velocities: &[String],
         decls: &IndexMap<Spanned<String>, Spanned<Number>>,
-    ) -> Vec<f64> {
-        let mut out = vec![0.0; coordinates.len() + velocities.len()];
+    ) -> Vec<(usize, String, Expr)> {
+        let mut out = Vec::new();
         for (name, value) in decls {
             let n = name.get_ref();
             let Some(slot) = coordinates.iter().chain(velocities).position(|c| c == n) else {
@@ -385,16 +470,149 @@ impl Validator<'_> {
                 );
                 continue;
             };
-            match initial_value(value.get_ref()) {
-                Ok(x) => out[slot] = x,
-                Err(why) => {
+            let text = match value.get_ref() {
+                Number::Int(i) => i.to_string(),
+                Number::Float(f) if f.is_finite() => format!("{f:e}"),
+                Number::Float(f) => {
                     self.cx.error(
-                        ErrorKind::Structure(format!("[initial] `{n}`: {why}")),
+                        ErrorKind::Structure(format!("[initial] `{n}`: {f} is not finite")),
                         Some(value.span()),
+                    );
+                    continue;
+                }
+                Number::Text(t) => t.clone(),
+            };
+            let e = self.expr(&Spanned::new(value.span(), text));
+            out.push((slot, n.clone(), e));
+        }
+        out
+    }
+
+    /// The initial values at the file's parameter values; names other than
+    /// parameters are reported.
+    fn initial_values(
+        &mut self,
+        params: &[Param],
+        derived: &[String],
+        definitions: &[(String, Expr)],
+        initial: Vec<(usize, String, Expr)>,
+        n: usize,
+    ) -> Vec<f64> {
+        let mut env: HashMap<String, f64> =
+            params.iter().map(|p| (p.name.clone(), p.value)).collect();
+        for (name, e) in definitions.iter().filter(|(d, _)| derived.contains(d)) {
+            if let Some(v) = e.node.value(&|k| env.get(k).copied()) {
+                env.insert(name.clone(), v);
+            }
+        }
+        let mut out = vec![0.0; n];
+        for (slot, name, e) in initial {
+            let mut foreign = None;
+            e.node.visit_names(&mut |k, r| {
+                if !params.iter().any(|p| p.name == k)
+                    && !derived.iter().any(|d| d == k)
+                    && foreign.is_none()
+                {
+                    foreign = Some((k.to_string(), r.clone()));
+                }
+            });
+            if let Some((k, r)) = foreign {
+                self.cx.error(
+                    ErrorKind::Structure(format!(
+                        "[initial] `{name}`: `{k}` is not a parameter; initial values may use parameters, pi and e"
+                    )),
+                    Some(e.at(&r)),
+                );
+                continue;
+            }
+            match e.node.value(&|k| env.get(k).copied()) {
+                Some(v) if v.is_finite() && slot < n => out[slot] = v,
+                _ => {
+                    self.cx.error(
+                        ErrorKind::Structure(format!(
+                            "[initial] `{name}`: `{}` has no finite real value at the file's parameters",
+                            e.text
+                        )),
+                        Some(e.span.clone()),
                     );
                 }
             }
         }
         out
     }
+
+    /// A derived parameter may use only parameters (and other derived
+    /// ones), pi and e.
+    fn only_parameters(&mut self, params: &[Param], derived: &[(Spanned<String>, Expr)]) {
+        for (name, e) in derived {
+            let mut bad = Vec::new();
+            e.node.visit_names(&mut |k, r| {
+                // Undeclared names are reported as unknown elsewhere.
+                if self.names.contains_key(k)
+                    && !params.iter().any(|p| p.name == k)
+                    && !derived.iter().any(|(d, _)| d.get_ref() == k)
+                {
+                    bad.push((k.to_string(), r.clone()));
+                }
+            });
+            for (k, r) in bad {
+                self.cx.error(
+                    ErrorKind::BadParameter {
+                        name: name.get_ref().clone(),
+                        why: format!(
+                            "`{k}` is not a parameter: a parameter's value may use other parameters, pi and e"
+                        ),
+                    },
+                    Some(e.at(&r)),
+                );
+            }
+        }
+    }
+}
+
+/// Most definitions a model may have.
+const MAX_DEFINITIONS: usize = 1000;
+/// Largest size (in nodes) of a definition once the definitions it uses are
+/// substituted.
+const MAX_EXPANDED_SIZE: u64 = 200_000;
+
+/// Whether definition `start` reaches itself through `uses`.
+fn reaches(uses: &[Vec<usize>], start: usize) -> bool {
+    let mut seen = vec![false; uses.len()];
+    let mut stack: Vec<usize> = uses[start].clone();
+    while let Some(i) = stack.pop() {
+        if i == start {
+            return true;
+        }
+        if !std::mem::replace(&mut seen[i], true) {
+            stack.extend(&uses[i]);
+        }
+    }
+    false
+}
+
+/// Indices in an order where each comes after those it uses (Kahn's
+/// algorithm); definitions on or behind a cycle come last.
+fn dependency_order(uses: &[Vec<usize>]) -> Vec<usize> {
+    let mut waiting: Vec<usize> = uses.iter().map(Vec::len).collect();
+    let mut users: Vec<Vec<usize>> = vec![Vec::new(); uses.len()];
+    for (i, u) in uses.iter().enumerate() {
+        for &j in u {
+            users[j].push(i);
+        }
+    }
+    let mut ready: Vec<usize> = (0..uses.len()).filter(|&i| waiting[i] == 0).rev().collect();
+    let mut order = Vec::with_capacity(uses.len());
+    while let Some(i) = ready.pop() {
+        order.push(i);
+        for &k in users[i].iter().rev() {
+            waiting[k] -= 1;
+            if waiting[k] == 0 {
+                ready.push(k);
+            }
+        }
+    }
+    let placed: std::collections::HashSet<usize> = order.iter().copied().collect();
+    order.extend((0..uses.len()).filter(|i| !placed.contains(i)));
+    order
 }

@@ -1,0 +1,141 @@
+//! Expression trees of the model file to symbolica expressions.
+//!
+//! Nothing of the model reaches symbolica as text: symbolica gives some bare
+//! names meanings of its own (`euler_e` is its e, `coeff` and `der` are its
+//! functions), so every model name becomes a symbol in the `dalembert`
+//! namespace, and π and e are symbols of ours that the evaluation pass turns
+//! into their values. `tan` is built as sin/cos and `sqrt` as a power ½, so
+//! derivatives stay within the functions the emitted code evaluates. Each
+//! division, logarithm and root is checked on the way: an expression that
+//! is undefined everywhere (`1/0`, `y/(x - x)`, `log(0)`, `sqrt(-1)`) is
+//! reported at its place instead of reaching later passes as infinity.
+
+use std::collections::HashMap;
+use std::ops::Range;
+
+use symbolica::prelude::*;
+
+use crate::ir::{Constant, Function, Node, NodeKind, Rational};
+
+/// The symbol of a model name.
+pub fn model_symbol(name: &str) -> Symbol {
+    symbol!(format!("dalembert::{name}").as_str())
+}
+
+/// The symbol standing for a constant until evaluation (`e` is reserved in
+/// model files and `π` is no identifier, so neither meets a model name).
+pub fn constant_symbol(c: Constant) -> Symbol {
+    match c {
+        Constant::Pi => symbol!("dalembert::π"),
+        Constant::E => symbol!("dalembert::e"),
+    }
+}
+
+/// Symbolica's own constants replaced by ours: `exp(1)` is normalised to its
+/// e, which must reach the emitted code as the number.
+pub fn own_constants(a: &Atom) -> Atom {
+    a.replace(Atom::from(Symbol::E))
+        .with(Atom::from(constant_symbol(Constant::E)))
+        .replace(Atom::from(Symbol::PI))
+        .with(Atom::from(constant_symbol(Constant::Pi)))
+}
+
+/// Why a tree cannot be built, and where (in the expression's text).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BuildError {
+    /// What is undefined.
+    pub message: String,
+    /// Where.
+    pub span: Range<usize>,
+}
+
+/// `node` as an expression; a name in `definitions` stands for its
+/// expression, any other for its model symbol.
+pub fn build(node: &Node, definitions: &HashMap<String, Atom>) -> Result<Atom, BuildError> {
+    let fail = |message: &str, span: &Range<usize>| BuildError {
+        message: message.to_string(),
+        span: span.clone(),
+    };
+    Ok(match &node.kind {
+        NodeKind::Number(r) => number(*r),
+        NodeKind::Name(n) => definitions
+            .get(n)
+            .cloned()
+            .unwrap_or_else(|| Atom::from(model_symbol(n))),
+        NodeKind::Constant(c) => Atom::from(constant_symbol(*c)),
+        NodeKind::Neg(x) => -build(x, definitions)?,
+        NodeKind::Sum(terms) => {
+            let mut out = Atom::num(0);
+            for (minus, t) in terms {
+                let t = build(t, definitions)?;
+                out = if *minus { out - t } else { out + t };
+            }
+            out
+        }
+        NodeKind::Product(factors) => {
+            let mut out = Atom::num(1);
+            for (divide, f) in factors {
+                let x = build(f, definitions)?;
+                if *divide {
+                    if x.is_zero() {
+                        return Err(fail("division by zero (the denominator is 0)", &f.span));
+                    }
+                    out = out / x;
+                } else {
+                    out = out * x;
+                }
+            }
+            out
+        }
+        NodeKind::Pow(b, n) => {
+            let base = build(b, definitions)?;
+            if n.num < 0 && base.is_zero() {
+                return Err(fail("0 raised to a negative power", &node.span));
+            }
+            if n.den != 1 && negative_number(&base) {
+                return Err(fail(
+                    "a fractional power of a negative number is not real",
+                    &node.span,
+                ));
+            }
+            base.pow(number(*n))
+        }
+        NodeKind::Call(f, x) => {
+            let arg = build(x, definitions)?;
+            match f {
+                Function::Sin => function!(Symbol::SIN, arg),
+                Function::Cos => function!(Symbol::COS, arg),
+                Function::Tan => function!(Symbol::SIN, arg.clone()) / function!(Symbol::COS, arg),
+                Function::Exp => function!(Symbol::EXP, arg),
+                Function::Log => {
+                    if arg.is_zero() || negative_number(&arg) {
+                        return Err(fail(
+                            "the logarithm of a number ≤ 0 is not real",
+                            &node.span,
+                        ));
+                    }
+                    function!(Symbol::LOG, arg)
+                }
+                Function::Sqrt => {
+                    if negative_number(&arg) {
+                        return Err(fail(
+                            "the square root of a negative number is not real",
+                            &node.span,
+                        ));
+                    }
+                    arg.pow(Atom::num(1) / Atom::num(2))
+                }
+            }
+        }
+    })
+}
+
+fn number(r: Rational) -> Atom {
+    // Validation keeps both parts within 2⁶⁰.
+    Atom::num(r.num as i64) / Atom::num(r.den as i64)
+}
+
+/// Whether `a` is a number below zero.
+fn negative_number(a: &Atom) -> bool {
+    matches!(a.as_view(), AtomView::Num(_)) && *a < Atom::num(0)
+}
