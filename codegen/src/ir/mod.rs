@@ -9,6 +9,7 @@ pub mod expr;
 mod file;
 mod names;
 mod number;
+mod order;
 mod validate;
 
 use std::collections::HashMap;
