@@ -78,7 +78,7 @@ fn compare<M: Walls<0, N>, const N: usize>(
     v: [f64; N],
     hand: impl Fn(&[f64; N]) -> [f64; N],
 ) {
-    let wall = M::WALLS[0];
+    let wall = model.walls()[0];
     let generated = model.collide(wall, &[], &v);
     let by_hand = hand(&v);
     for i in 0..N {
@@ -133,11 +133,11 @@ fn chains(c: &mut Criterion) {
         g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
     ) {
         let m = M::default();
-        let q = M::INITIAL_COORDINATES;
+        let q = m.initial_coordinates();
         let v: [f64; N] = std::array::from_fn(|i| 0.3 - 0.1 * i as f64);
-        let w = M::WALLS[0];
+        let w = m.walls()[0];
         assert!(m.collide(w, &q, &v).iter().all(|x| x.is_finite()));
-        g.bench_function(M::NAME, |b| {
+        g.bench_function(m.name(), |b| {
             b.iter(|| m.collide(w, black_box(&q), black_box(&v)))
         });
     }

@@ -26,21 +26,21 @@ use dalembert::runtime::dynamics::{accelerations, qdd};
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{Integrator, Rk4, Settings, Simulator, State};
 
-fn initial<M: Dynamics<N>, const N: usize>() -> State<N> {
+fn initial<M: Dynamics<N>, const N: usize>(m: &M) -> State<N> {
     State {
         t: 0.0,
-        q: M::INITIAL_COORDINATES,
-        v: M::INITIAL_VELOCITIES,
+        q: m.initial_coordinates(),
+        v: m.initial_velocities(),
     }
 }
 
 fn eom<M: Dynamics<N> + Default, const N: usize>(c: &mut Criterion) {
     let m = M::default();
-    let s = initial::<M, N>();
-    c.bench_function(&format!("eom/{}/qdd", M::NAME), |b| {
+    let s = initial(&m);
+    c.bench_function(&format!("eom/{}/qdd", m.name()), |b| {
         b.iter(|| qdd(black_box(&m), black_box(&s.q), black_box(&s.v)).unwrap())
     });
-    c.bench_function(&format!("eom/{}/numeric", M::NAME), |b| {
+    c.bench_function(&format!("eom/{}/numeric", m.name()), |b| {
         b.iter(|| accelerations(black_box(&m), black_box(&s.q), black_box(&s.v)).unwrap())
     });
 }
@@ -55,9 +55,9 @@ fn rk4() -> Settings {
 fn step<M: Surfaces<N> + Default, const N: usize>(c: &mut Criterion) {
     let m = M::default();
     for (name, settings) in [("dormand_prince", Settings::default()), ("rk4", rk4())] {
-        c.bench_function(&format!("step/{}/{name}", M::NAME), |b| {
+        c.bench_function(&format!("step/{}/{name}", m.name()), |b| {
             b.iter_batched(
-                || Simulator::new(&m, initial::<M, N>(), settings).unwrap(),
+                || Simulator::new(&m, initial(&m), settings).unwrap(),
                 |mut sim| black_box(sim.step(f64::INFINITY).unwrap()),
                 BatchSize::SmallInput,
             )
@@ -74,8 +74,7 @@ fn simulate(c: &mut Criterion) {
         group.throughput(Throughput::Elements(bounces));
         group.bench_function(format!("ball_bounce_{bounces}_bounces"), |b| {
             b.iter(|| {
-                let mut sim =
-                    Simulator::new(&ball, initial::<BallBounce, 6>(), Settings::default()).unwrap();
+                let mut sim = Simulator::new(&ball, initial(&ball), Settings::default()).unwrap();
                 let stats = sim.run((bounces as f64 + 0.5) * flight, |_| true).unwrap();
                 assert_eq!(stats.collisions, bounces);
                 stats
@@ -84,8 +83,7 @@ fn simulate(c: &mut Criterion) {
     }
     let rolling = BallWallEuler::default();
     let run = || {
-        let mut sim =
-            Simulator::new(&rolling, initial::<BallWallEuler, 5>(), Settings::default()).unwrap();
+        let mut sim = Simulator::new(&rolling, initial(&rolling), Settings::default()).unwrap();
         sim.run(5.0, |_| true).unwrap()
     };
     group.throughput(Throughput::Elements(run().steps));

@@ -40,12 +40,12 @@ fn check_motion<M: Dynamics<N>, const N: usize>(m: &M, seed: u64) {
         let (qm, vm) = (step(&q, &v, -eps), step(&v, &a, -eps));
         let de = (m.energy(&qp, &vp) - m.energy(&qm, &vm)) / (2.0 * eps);
         let scale = 1.0 + m.kinetic_energy(&q, &v).abs();
-        assert!(de.abs() < 1e-6 * scale, "{}: dE/dt = {de}", M::NAME);
+        assert!(de.abs() < 1e-6 * scale, "{}: dE/dt = {de}", m.name());
         let ap = m.constraints(&qp).apply(&vp);
         let am = m.constraints(&qm).apply(&vm);
         for (x, y) in ap.as_slice().iter().zip(am.as_slice()) {
             let d = (x - y) / (2.0 * eps);
-            assert!(d.abs() < 1e-6 * scale, "{}: d(Aq̇)/dt = {d}", M::NAME);
+            assert!(d.abs() < 1e-6 * scale, "{}: d(Aq̇)/dt = {d}", m.name());
         }
     }
 }
@@ -103,7 +103,7 @@ fn check_closed_form<M: Dynamics<N>, const N: usize>(
     let a = m.constraints(q);
     let v = onto_kernel(&a, v);
     let Some(x) = m.closed_form_accelerations(q, &v) else {
-        return Err(TestCaseError::fail(format!("{}: no closed form", M::NAME)));
+        return Err(TestCaseError::fail(format!("{}: no closed form", m.name())));
     };
     let h = m.forcing(q, &v);
     let gx = mat_vec(&m.mass_matrix(q), &x);
@@ -122,7 +122,7 @@ fn check_closed_form<M: Dynamics<N>, const N: usize>(
     prop_assert!(
         off.amax() <= 1e-9 * scale,
         "{}: G q̈ + h off the row space of A by {}",
-        M::NAME,
+        m.name(),
         off.amax()
     );
     let drift = m.constraint_drift(q, &v);
@@ -131,7 +131,7 @@ fn check_closed_form<M: Dynamics<N>, const N: usize>(
         prop_assert!(
             (ax + c).abs() <= 1e-9 * scale,
             "{}: A q̈ + Ȧq̇ = {}",
-            M::NAME,
+            m.name(),
             ax + c
         );
     }
@@ -140,7 +140,7 @@ fn check_closed_form<M: Dynamics<N>, const N: usize>(
 
 /// 256 random cases (see `common::for_random_cases`), on every model with a
 /// closed form.
-fn closed_form<M: Dynamics<N>, const N: usize>() {
+fn closed_form<M: Dynamics<N> + FromParams, const N: usize>() {
     let defaults = M::with_params(Default::default());
     if defaults
         .closed_form_accelerations(&[0.5; N], &[0.0; N])

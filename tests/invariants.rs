@@ -33,7 +33,7 @@ fn max_abs<const N: usize>(m: &[[f64; N]; N]) -> f64 {
 struct At<'a, M: Walls<Q, N>, const Q: usize, const N: usize> {
     model: &'a M,
     wall: M::Wall,
-    name: &'static str,
+    name: &'a str,
     q: &'a [f64; Q],
     v: [f64; N],
     g: [[f64; N]; N],
@@ -50,12 +50,12 @@ fn check<M: Walls<Q, N>, const Q: usize, const N: usize>(
 ) -> Result<(), TestCaseError> {
     let a = model.constraints(q);
     let v = onto_kernel(&a, v);
-    for &wall in M::WALLS {
+    for &wall in model.walls() {
         let p = model.projector(wall, q);
         let at = At {
             model,
             wall,
-            name: M::wall_name(wall),
+            name: model.wall_name(wall),
             q,
             v,
             g: model.mass_matrix(q),
@@ -85,7 +85,7 @@ fn projector_is_g_orthogonal<M: Walls<Q, N>, const Q: usize, const N: usize>(
             prop_assert!(
                 close(p2[i][j], p[i][j], scale * scale),
                 "{} {name}: P² ≠ P at ({i},{j})",
-                M::NAME
+                at.model.name()
             );
         }
     }
@@ -98,7 +98,7 @@ fn projector_is_g_orthogonal<M: Walls<Q, N>, const Q: usize, const N: usize>(
             prop_assert!(
                 close(gp[i][j], ptg, gs),
                 "{} {name}: GP ≠ PᵀG at ({i},{j})",
-                M::NAME
+                at.model.name()
             );
         }
     }
@@ -128,7 +128,7 @@ fn normal_is_b_first_row<M: Walls<Q, N>, const Q: usize, const N: usize>(
         prop_assert!(
             close(normal[j], row[j], size),
             "{} {name}: normal ≠ B's first row at {j}",
-            M::NAME
+            at.model.name()
         );
     }
     let nv: f64 = row.iter().zip(&v).map(|(x, y)| x * y).sum();
@@ -136,7 +136,7 @@ fn normal_is_b_first_row<M: Walls<Q, N>, const Q: usize, const N: usize>(
     prop_assert!(
         close(model.normal_velocity(wall, q, &v), nv, vs),
         "{} {name}: normal velocity ≠ B's first row · v",
-        M::NAME
+        at.model.name()
     );
     Ok(())
 }
@@ -169,7 +169,7 @@ fn rows_are_kept<M: Walls<Q, N>, const Q: usize, const N: usize>(
                         scale * row.iter().fold(0.0_f64, |m, x| m.max(x.abs()))
                     ),
                     "{} {name}: {what}P ≠ {what} in column {j}",
-                    M::NAME
+                    at.model.name()
                 );
             }
         }
@@ -182,7 +182,7 @@ fn rows_are_kept<M: Walls<Q, N>, const Q: usize, const N: usize>(
             prop_assert!(
                 (p_generic[i][j] - p[i][j]).abs() <= 1e-7 * (1.0 + scale),
                 "{} {name}: generated P differs from the generic path at ({i},{j}): {} vs {}",
-                M::NAME,
+                at.model.name(),
                 p[i][j],
                 p_generic[i][j]
             );
@@ -214,32 +214,32 @@ fn collision_map<M: Walls<Q, N>, const Q: usize, const N: usize>(
     prop_assert!(
         close(e0, e1, e0.abs()),
         "{} {name}: energy not kept: {e0} → {e1}",
-        M::NAME
+        at.model.name()
     );
     prop_assert!(
         close(model.kinetic_energy(q, &v), e0, e0.abs()),
         "{} {name}: T(q,v) ≠ ½vᵀGv",
-        M::NAME
+        at.model.name()
     );
     let vmax = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
     prop_assert!(
         a.apply(&vp).max_abs() <= TOL * (1.0 + vmax * 10.0),
         "{} {name}: v⁺ ∉ ker A",
-        M::NAME
+        at.model.name()
     );
     let n0 = model.normal_velocity(wall, q, &v);
     let n1 = model.normal_velocity(wall, q, &vp);
     prop_assert!(
         close(n1, -n0, vmax),
         "{} {name}: normal velocity {n0} → {n1}, not reversed",
-        M::NAME
+        at.model.name()
     );
     let back = model.collide(wall, q, &vp);
     for i in 0..N {
         prop_assert!(
             close(back[i], v[i], vmax),
             "{} {name}: the collision map is not an involution",
-            M::NAME
+            at.model.name()
         );
     }
     // Same as (I − 2P)v computed from P.
@@ -248,7 +248,7 @@ fn collision_map<M: Walls<Q, N>, const Q: usize, const N: usize>(
         prop_assert!(
             close(vp[i], v[i] - 2.0 * pv[i], vmax * (1.0 + scale)),
             "{} {name}: collide ≠ (I − 2P)v",
-            M::NAME
+            at.model.name()
         );
     }
     Ok(())
@@ -261,8 +261,8 @@ fn check_hessian<M: Surfaces<N>, const N: usize>(
     q: &[f64; N],
     v: [f64; N],
 ) -> Result<(), TestCaseError> {
-    for &wall in M::WALLS {
-        let name = M::wall_name(wall);
+    for &wall in model.walls() {
+        let name = model.wall_name(wall);
         let row = model.normal(wall, q);
         let size = row.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
         let eps = 1e-5;
@@ -278,14 +278,14 @@ fn check_hessian<M: Surfaces<N>, const N: usize>(
         prop_assert!(
             hessian.is_some_and(|h| (h - difference).abs() <= 1e-5 * (1.0 + size * vmax * vmax)),
             "{} {name}: vᵀ∇²f v = {hessian:?}, a central difference gives {difference}",
-            M::NAME
+            model.name()
         );
     }
     Ok(())
 }
 
 /// 512 random cases (see `common::for_random_cases`).
-fn run<M: Walls<Q, N>, const Q: usize, const N: usize>() {
+fn run<M: Walls<Q, N> + FromParams, const Q: usize, const N: usize>() {
     for_random_cases::<M, Q, N>(512, check);
 }
 
@@ -312,16 +312,17 @@ for_each_model!(invariant_test);
 struct Reversing(BallFloor);
 
 impl Model<0, 6> for Reversing {
-    type Params = ball_floor::Params;
-    const NAME: &'static str = "reversing";
-    const COORDINATES: &'static [&'static str] = &[];
-    const VELOCITIES: &'static [&'static str] = BallFloor::VELOCITIES;
-    const PARAMETERS: &'static [&'static str] = BallFloor::PARAMETERS;
-    fn with_params(p: Self::Params) -> Self {
-        Self(BallFloor::with_params(p))
+    fn name(&self) -> &str {
+        "reversing"
     }
-    fn params(&self) -> &Self::Params {
-        &self.0.params
+    fn coordinate_names(&self) -> &[&str] {
+        &[]
+    }
+    fn velocity_names(&self) -> &[&str] {
+        self.0.velocity_names()
+    }
+    fn parameter_names(&self) -> &[&str] {
+        self.0.parameter_names()
     }
     fn parameter(&self, i: usize) -> Option<f64> {
         self.0.parameter(i)
@@ -342,9 +343,11 @@ impl Model<0, 6> for Reversing {
 
 impl Walls<0, 6> for Reversing {
     type Wall = ball_floor::Wall;
-    const WALLS: &'static [ball_floor::Wall] = BallFloor::WALLS;
-    fn wall_name(w: Self::Wall) -> &'static str {
-        BallFloor::wall_name(w)
+    fn walls(&self) -> &[Self::Wall] {
+        self.0.walls()
+    }
+    fn wall_name(&self, w: Self::Wall) -> &str {
+        self.0.wall_name(w)
     }
     fn wall_rows(&self, w: Self::Wall, q: &[f64; 0]) -> Rows<6> {
         self.0.wall_rows(w, q)

@@ -192,7 +192,7 @@ fn every_function_and_constant_reaches_the_emitted_programs() {
 
         // h of G q̈ + h = Aᵀλ: ∂²T/∂v∂q · q̇ − ∂T/∂q + ∂V/∂q.
         let forcing = eval(&d, Quantity::Forcing, &inputs);
-        for i in 0..4 {
+        for (i, &got) in forcing.iter().enumerate().take(4) {
             let dt_dvi = |x: &[f64], w: &[f64]| {
                 let tw = |u: &[f64]| t(x, u);
                 partial(&tw, w, i)
@@ -201,7 +201,7 @@ fn every_function_and_constant_reaches_the_emitted_programs() {
                 .map(|j| partial(&|x: &[f64]| dt_dvi(x, &v), &q, j) * v[j])
                 .sum();
             let want = mixed - partial(&|x: &[f64]| t(x, &v), &q, i) + partial(&potential, &q, i);
-            close(&format!("forcing[{i}]"), forcing[i], want, 1e-5);
+            close(&format!("forcing[{i}]"), got, want, 1e-5);
         }
 
         for (w, f) in [(0, rim as fn(&[f64]) -> f64), (1, floor)] {
@@ -212,8 +212,8 @@ fn every_function_and_constant_reaches_the_emitted_programs() {
                 1e-12,
             );
             let normal = wall_eval(&d, w, Quantity::Normal, &inputs);
-            for k in 0..4 {
-                close(&format!("df[{k}]"), normal[k], partial(&f, &q, k), 1e-7);
+            for (k, &df) in normal.iter().enumerate().take(4) {
+                close(&format!("df[{k}]"), df, partial(&f, &q, k), 1e-7);
             }
             let hess = wall_eval(&d, w, Quantity::SurfaceHessian, &inputs)[0];
             close("vᵀ∇²f v", hess, second_along(&f, &q, &v), 1e-4);

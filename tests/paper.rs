@@ -163,13 +163,18 @@ fn euler_angle_ball_agrees_with_the_paper_model() {
 /// evaluation of the symbolic P and (I − 2P)v at random parameters,
 /// configurations and velocities.
 #[allow(clippy::needless_range_loop)]
-fn numeric_agrees<M: Walls<Q, N>, const Q: usize, const N: usize>(file: &str) {
+fn numeric_agrees<M: Walls<Q, N> + FromParams, const Q: usize, const N: usize>(file: &str) {
     let d = derived(file);
     let mut seed = 7u64;
     for _ in 0..5 {
         let mut model = M::with_params(Default::default());
         let mut values: Vec<(String, f64)> = Vec::new();
-        for (i, name) in M::PARAMETERS.iter().enumerate() {
+        let names: Vec<String> = model
+            .parameter_names()
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        for (i, name) in names.iter().enumerate() {
             let x = model.parameter(i).unwrap() * (0.5 + 1.5 * lcg(&mut seed));
             model.set_parameter(i, x);
             values.push((name.to_string(), x));
@@ -177,15 +182,22 @@ fn numeric_agrees<M: Walls<Q, N>, const Q: usize, const N: usize>(file: &str) {
         let q: [f64; Q] = std::array::from_fn(|_| 0.2 + 1.2 * lcg(&mut seed));
         let v: [f64; N] = std::array::from_fn(|_| -2.0 + 4.0 * lcg(&mut seed));
         values.extend(
-            M::COORDINATES
+            model
+                .coordinate_names()
                 .iter()
                 .zip(q)
                 .map(|(n, x)| (n.to_string(), x)),
         );
-        values.extend(M::VELOCITIES.iter().zip(v).map(|(n, x)| (n.to_string(), x)));
+        values.extend(
+            model
+                .velocity_names()
+                .iter()
+                .zip(v)
+                .map(|(n, x)| (n.to_string(), x)),
+        );
         let refs: Vec<(&str, f64)> = values.iter().map(|(n, x)| (n.as_str(), *x)).collect();
-        for (w, wd) in M::WALLS.iter().zip(&d.walls) {
-            assert_eq!(M::wall_name(*w), wd.name);
+        for (w, wd) in model.walls().iter().zip(&d.walls) {
+            assert_eq!(model.wall_name(*w), wd.name);
             let Projection::ClosedForm {
                 projector,
                 collision,

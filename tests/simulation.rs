@@ -54,11 +54,12 @@ fn dormand_prince(rtol: f64) -> Settings {
 }
 
 /// The model file's initial state.
-fn initial<M: Dynamics<N>, const N: usize>() -> State<N> {
+fn initial<M: Dynamics<N> + Default, const N: usize>() -> State<N> {
+    let m = M::default();
     State {
         t: 0.0,
-        q: M::INITIAL_COORDINATES,
-        v: M::INITIAL_VELOCITIES,
+        q: m.initial_coordinates(),
+        v: m.initial_velocities(),
     }
 }
 

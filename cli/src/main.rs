@@ -193,7 +193,7 @@ fn section_3_2_1_collision_map() {
     let p = ball.params;
     let (v, u) = (1.5, 2.0);
     let v_minus = [-v, 0.0, -u, 0.0, p.r * p.m * v / p.J, 0.0];
-    let v_plus = ball.collide(<BallFloor as Walls<0, 6>>::WALLS[0], &[], &v_minus);
+    let v_plus = ball.collide(BallFloor::WALLS[0], &[], &v_minus);
     println!(
         "==================== §3.2.1: nonholonomic pendulum (generated code) ===================="
     );

@@ -22,6 +22,7 @@ fn range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
 /// Three panels: the coordinates over time, the path, and the energy drift.
 pub fn plot<M: Surfaces<N>, const N: usize>(
     file: &Path,
+    model: &M,
     rows: &[Row<N>],
     axes: (usize, usize),
     e0: f64,
@@ -30,8 +31,8 @@ pub fn plot<M: Surfaces<N>, const N: usize>(
         let root = SVGBackend::new(file, (1000, 1200)).into_drawing_area();
         root.fill(&WHITE).map_err(text)?;
         let panels = root.split_evenly((3, 1));
-        coordinates_panel::<M, N>(&panels[0], rows)?;
-        path_panel::<M, N>(&panels[1], rows, axes)?;
+        coordinates_panel(&panels[0], model, rows)?;
+        path_panel(&panels[1], model, rows, axes)?;
         energy_panel(&panels[2], rows, e0)?;
         root.present().map_err(text)
     })();
@@ -52,10 +53,11 @@ fn times<const N: usize>(rows: &[Row<N>]) -> std::ops::Range<f64> {
 /// Every coordinate against time.
 fn coordinates_panel<M: Surfaces<N>, const N: usize>(
     area: &Panel<'_>,
+    model: &M,
     rows: &[Row<N>],
 ) -> Result<(), String> {
     let mut chart = ChartBuilder::on(area)
-        .caption(format!("{}: coordinates", M::NAME), ("sans-serif", 22))
+        .caption(format!("{}: coordinates", model.name()), ("sans-serif", 22))
         .margin(12)
         .x_label_area_size(36)
         .y_label_area_size(60)
@@ -67,7 +69,7 @@ fn coordinates_panel<M: Surfaces<N>, const N: usize>(
         chart
             .draw_series(LineSeries::new(rows.iter().map(|r| (r.t, r.q[i])), color))
             .map_err(text)?
-            .label(M::COORDINATES[i])
+            .label(model.coordinate_names()[i])
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
     }
     chart
@@ -81,12 +83,14 @@ fn coordinates_panel<M: Surfaces<N>, const N: usize>(
 /// Coordinate b against coordinate a, the collisions marked.
 fn path_panel<M: Surfaces<N>, const N: usize>(
     area: &Panel<'_>,
+    model: &M,
     rows: &[Row<N>],
     (a, b): (usize, usize),
 ) -> Result<(), String> {
+    let names = model.coordinate_names();
     let mut path = ChartBuilder::on(area)
         .caption(
-            format!("path: {} against {}", M::COORDINATES[b], M::COORDINATES[a]),
+            format!("path: {} against {}", names[b], names[a]),
             ("sans-serif", 22),
         )
         .margin(12)
@@ -98,8 +102,8 @@ fn path_panel<M: Surfaces<N>, const N: usize>(
         )
         .map_err(text)?;
     path.configure_mesh()
-        .x_desc(M::COORDINATES[a])
-        .y_desc(M::COORDINATES[b])
+        .x_desc(names[a])
+        .y_desc(names[b])
         .draw()
         .map_err(text)?;
     path.draw_series(LineSeries::new(rows.iter().map(|r| (r.q[a], r.q[b])), BLUE))

@@ -1,5 +1,7 @@
-//! `dalembert simulate`: runs the hybrid simulator on a built-in model and
-//! writes the trajectory as CSV and an SVG plot.
+//! `dalembert simulate`: runs the hybrid simulator on a built-in model
+//! (compiled) or on a model file (derived now and interpreted,
+//! [`dalembert_codegen::interpret`]) and writes the trajectory as CSV and an
+//! SVG plot.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -12,6 +14,8 @@ use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
     DormandPrince, Integrator, Residual, Rk4, Settings, Simulator, State, admissible, residual,
 };
+use dalembert_codegen::Derivation;
+use dalembert_codegen::interpret::Interpreted;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::plot::plot;
@@ -27,7 +31,8 @@ pub enum Method {
 
 #[derive(Args, Debug)]
 pub struct SimulateArgs {
-    /// A built-in model with coordinates (listed below).
+    /// A model file (`path/to/model.toml`) or a built-in model with
+    /// coordinates (listed below).
     #[arg(long_help = models_help())]
     pub model: String,
     /// Simulate from t = 0 to this time.
@@ -71,7 +76,11 @@ fn models_help() -> String {
         };
     }
     for_each_model!(with_coordinates);
-    format!("A built-in model with coordinates: {}", names.join(", "))
+    format!(
+        "A model file (a path ending in `.toml`: derived and interpreted at once, no Rust \
+         to write), or a built-in model with coordinates (compiled): {}",
+        names.join(", ")
+    )
 }
 
 fn assignment(s: &str) -> Result<(String, f64), String> {
@@ -90,6 +99,9 @@ fn assignment(s: &str) -> Result<(String, f64), String> {
 
 /// Runs `dalembert simulate`.
 pub fn simulate(args: &SimulateArgs) -> Result<bool, String> {
+    if is_model_file(&args.model) {
+        return simulate_file(args);
+    }
     let mut known = Vec::new();
     macro_rules! dispatch {
         ($module:ident, $ty:ident, 0, $n:literal) => {
@@ -104,17 +116,60 @@ pub fn simulate(args: &SimulateArgs) -> Result<bool, String> {
         };
         ($module:ident, $ty:ident, $q:literal, $n:literal) => {
             if args.model == stringify!($module) {
-                return run::<$ty, $q>(args);
+                return run::<$ty, $q>(args, <$ty>::with_params(Default::default()), &[]);
             }
             known.push(stringify!($module));
         };
     }
     for_each_model!(dispatch);
     Err(format!(
-        "no built-in model `{}`; models with coordinates: {}",
+        "no built-in model `{}` (and no model file of that name); models with coordinates: {}",
         args.model,
         known.join(", ")
     ))
+}
+
+/// Whether the MODEL argument names a file rather than a built-in model:
+/// a path ending in `.toml`, or an existing file.
+fn is_model_file(model: &str) -> bool {
+    model.ends_with(".toml") || Path::new(model).is_file()
+}
+
+/// Most velocity components of a model file the CLI interprets: its
+/// simulator is compiled once for each size up to this.
+pub const MAX_INTERPRETED: usize = 16;
+
+/// `simulate path/to/model.toml`: the model derived now and its programs
+/// interpreted by the same simulator as the built-in models.
+fn simulate_file(args: &SimulateArgs) -> Result<bool, String> {
+    let path = Path::new(&args.model);
+    if !path.is_file() {
+        return Err(format!("no model file {}", path.display()));
+    }
+    checked_spacing(args)?;
+    let d: Derivation = dalembert_codegen::derive(path).map_err(|e| e.render())?;
+    let n = d.model.velocities.len();
+    macro_rules! sizes {
+        ($($n:literal)*) => {
+            match n {
+                $($n => {
+                    let model = Interpreted::<$n>::new(&d).map_err(|e| e.to_string())?;
+                    run::<Interpreted<$n>, $n>(args, model, &d.model.derived)
+                })*
+                _ => Err(format!(
+                    "`{}` has {n} velocities; the CLI interprets models of 1 to {MAX_INTERPRETED}: generate its Rust code (`dalembert generate`) and simulate it from a crate",
+                    d.model.name
+                )),
+            }
+        };
+    }
+    if d.model.coordinates.is_empty() {
+        return Err(format!(
+            "`{}` is an instantaneous model (velocities at the collision instant only): it has no motion to simulate",
+            d.model.name
+        ));
+    }
+    sizes!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16)
 }
 
 /// One output row.
@@ -124,7 +179,7 @@ pub struct Row<const N: usize> {
     pub v: [f64; N],
     pub energy: f64,
     pub residual: [f64; 2],
-    pub event: Option<&'static str>,
+    pub event: Option<String>,
 }
 
 /// Most rows a run may write (CSV rows at the `--every` spacing).
@@ -174,10 +229,15 @@ fn checked_spacing(args: &SimulateArgs) -> Result<f64, String> {
     Ok(every)
 }
 
-fn run<M: Surfaces<N>, const N: usize>(args: &SimulateArgs) -> Result<bool, String> {
+/// Simulates `model` (whose derived parameters are `derived`) as `args` say.
+fn run<M: Surfaces<N>, const N: usize>(
+    args: &SimulateArgs,
+    model: M,
+    derived: &[String],
+) -> Result<bool, String> {
     let every = checked_spacing(args)?;
-    let path = path_axes::<M, N>(args.path.as_deref())?;
-    let (model, start, start_residual) = start::<M, N>(args)?;
+    let path = path_axes(&model, args.path.as_deref())?;
+    let (model, start, start_residual) = start(args, model, derived)?;
     let e0 = model.energy(&start.q, &start.v);
     if !e0.is_finite() {
         return Err(format!(
@@ -187,10 +247,10 @@ fn run<M: Surfaces<N>, const N: usize>(args: &SimulateArgs) -> Result<bool, Stri
     let mut sim = Simulator::new(&model, start, settings(args)).map_err(|e| e.to_string())?;
     std::fs::create_dir_all(&args.out)
         .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
-    let csv = args.out.join(format!("{}.csv", M::NAME));
-    let svg = args.out.join(format!("{}.svg", M::NAME));
-    let mut out = Output::<N>::create::<M>(&csv, e0)?;
-    out.push::<M>(Row {
+    let csv = args.out.join(format!("{}.csv", model.name()));
+    let svg = args.out.join(format!("{}.svg", model.name()));
+    let mut out = Output::<N>::create(&model, &csv, e0)?;
+    out.push(Row {
         t: 0.0,
         q: start.q,
         v: start.v,
@@ -199,11 +259,11 @@ fn run<M: Surfaces<N>, const N: usize>(args: &SimulateArgs) -> Result<bool, Stri
         event: None,
     })?;
     let clock = Instant::now();
-    let failure = integrate(&mut sim, args.t_end, every, &mut out)?;
+    let failure = integrate(&mut sim, &model, args.t_end, every, &mut out)?;
     let elapsed = clock.elapsed();
     out.finish()?;
-    plot::<M, N>(&svg, &out.kept, path, e0)?;
-    summary(&sim, args, &out, e0, elapsed.as_secs_f64());
+    plot(&svg, &model, &out.kept, path, e0)?;
+    summary(&sim, &model, args, &out, e0, elapsed.as_secs_f64());
     println!("  trajectory: {} ({} rows)", csv.display(), out.written);
     println!("  plot:       {}", svg.display());
     match failure {
@@ -230,7 +290,7 @@ struct Output<const N: usize> {
 }
 
 impl<const N: usize> Output<N> {
-    fn create<M: Surfaces<N>>(path: &Path, e0: f64) -> Result<Self, String> {
+    fn create<M: Surfaces<N>>(model: &M, path: &Path, e0: f64) -> Result<Self, String> {
         let file = std::fs::File::create(path)
             .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         let mut out = Self {
@@ -244,7 +304,11 @@ impl<const N: usize> Output<N> {
             worst: [0.0; 2],
         };
         let mut header = String::from("t");
-        for name in M::COORDINATES.iter().chain(M::VELOCITIES) {
+        for name in model
+            .coordinate_names()
+            .iter()
+            .chain(model.velocity_names())
+        {
             header.push(',');
             header.push_str(name);
         }
@@ -260,7 +324,7 @@ impl<const N: usize> Output<N> {
             .map_err(|e| format!("cannot write {}: {e}", self.path.display()))
     }
 
-    fn push<M: Surfaces<N>>(&mut self, r: Row<N>) -> Result<(), String> {
+    fn push(&mut self, r: Row<N>) -> Result<(), String> {
         let mut line = String::new();
         let _ = write!(line, "{:e}", r.t);
         for x in r.q.iter().chain(&r.v) {
@@ -272,7 +336,7 @@ impl<const N: usize> Output<N> {
             r.energy,
             r.residual[0],
             r.residual[1],
-            r.event.unwrap_or("")
+            r.event.as_deref().unwrap_or("")
         );
         self.write(&line)?;
         self.drift = self.drift.max((r.energy - self.e0).abs());
@@ -280,7 +344,7 @@ impl<const N: usize> Output<N> {
             self.worst[0].max(r.residual[0]),
             self.worst[1].max(r.residual[1]),
         ];
-        if self.written % self.stride == 0 || r.event.is_some() {
+        if self.written.is_multiple_of(self.stride) || r.event.is_some() {
             self.kept.push(r);
         }
         self.written += 1;
@@ -308,22 +372,28 @@ impl<const N: usize> Output<N> {
 /// `[initial]` with `--set` applied, q on h(q) = 0, q̇ projected onto ker A.
 fn start<M: Surfaces<N>, const N: usize>(
     args: &SimulateArgs,
+    mut model: M,
+    derived: &[String],
 ) -> Result<(M, State<N>, Residual), String> {
-    let mut model = M::with_params(Default::default());
-    let mut q = M::INITIAL_COORDINATES;
-    let mut v = M::INITIAL_VELOCITIES;
+    let mut q = model.initial_coordinates();
+    let mut v = model.initial_velocities();
     for (name, value) in &args.set {
-        if let Some(i) = M::COORDINATES.iter().position(|c| c == name) {
+        if let Some(i) = model.coordinate_names().iter().position(|c| c == name) {
             q[i] = *value;
-        } else if let Some(i) = M::VELOCITIES.iter().position(|c| c == name) {
+        } else if let Some(i) = model.velocity_names().iter().position(|c| c == name) {
             v[i] = *value;
+        } else if derived.contains(name) {
+            return Err(format!(
+                "`{name}` is a derived parameter of {} (its value is computed from other parameters): set those instead",
+                model.name()
+            ));
         } else if !model.set_parameter_named(name, *value) {
             return Err(format!(
                 "`{name}` is not a parameter ({}), coordinate ({}) or velocity ({}) of {}",
-                M::PARAMETERS.join(", "),
-                M::COORDINATES.join(", "),
-                M::VELOCITIES.join(", "),
-                M::NAME
+                model.parameter_names().join(", "),
+                model.coordinate_names().join(", "),
+                model.velocity_names().join(", "),
+                model.name()
             ));
         }
     }
@@ -368,6 +438,7 @@ fn settings(args: &SimulateArgs) -> Settings {
 /// progress bar; the error that stopped it early, if any.
 fn integrate<M: Surfaces<N>, const N: usize>(
     sim: &mut Simulator<'_, M, N>,
+    model: &M,
     t_end: f64,
     every: f64,
     out: &mut Output<N>,
@@ -380,7 +451,7 @@ fn integrate<M: Surfaces<N>, const N: usize>(
         .map_err(|e| e.to_string())?
         .progress_chars("=> "),
     );
-    bar.set_message(format!("simulating {}", M::NAME));
+    bar.set_message(format!("simulating {}", model.name()));
     let mut k = 1.0;
     let mut failure = None;
     let mut last_energy = out.e0;
@@ -396,13 +467,13 @@ fn integrate<M: Surfaces<N>, const N: usize>(
         let residual = [step.residual.velocity, step.residual.position];
         if let Some(c) = &step.collision {
             // The state just before the collision, from its record.
-            out.push::<M>(Row {
+            out.push(Row {
                 t: c.t,
                 q: c.q,
                 v: c.v_minus,
                 energy: last_energy,
                 residual,
-                event: Some(M::wall_name(c.wall)),
+                event: Some(model.wall_name(c.wall).to_string()),
             })?;
         }
         last_energy = step.energy;
@@ -411,7 +482,7 @@ fn integrate<M: Surfaces<N>, const N: usize>(
             failure = Some(format!("the energy became {} at t = {}", step.energy, s.t));
         }
         if s.t >= target || step.collision.is_some() || failure.is_some() {
-            out.push::<M>(Row {
+            out.push(Row {
                 t: s.t,
                 q: s.q,
                 v: s.v,
@@ -435,6 +506,7 @@ fn integrate<M: Surfaces<N>, const N: usize>(
 /// Steps, collisions, evaluations, time, energy drift and residuals.
 fn summary<M: Surfaces<N>, const N: usize>(
     sim: &Simulator<'_, M, N>,
+    model: &M,
     args: &SimulateArgs,
     out: &Output<N>,
     e0: f64,
@@ -443,7 +515,7 @@ fn summary<M: Surfaces<N>, const N: usize>(
     let stats = sim.stats();
     println!(
         "{}: t = 0 → {} with {:?}",
-        M::NAME,
+        model.name(),
         sim.state().t,
         args.integrator
     );
@@ -469,18 +541,19 @@ fn summary<M: Surfaces<N>, const N: usize>(
 }
 
 /// Indices of the two coordinates drawn as the path.
-fn path_axes<M: Surfaces<N>, const N: usize>(spec: Option<&str>) -> Result<(usize, usize), String> {
+fn path_axes<M: Surfaces<N>, const N: usize>(
+    model: &M,
+    spec: Option<&str>,
+) -> Result<(usize, usize), String> {
+    let names = model.coordinate_names();
     let find = |name: &str| {
-        M::COORDINATES
-            .iter()
-            .position(|c| *c == name.trim())
-            .ok_or_else(|| {
-                format!(
-                    "--path: `{name}` is not a coordinate of {} ({})",
-                    M::NAME,
-                    M::COORDINATES.join(", ")
-                )
-            })
+        names.iter().position(|c| *c == name.trim()).ok_or_else(|| {
+            format!(
+                "--path: `{name}` is not a coordinate of {} ({})",
+                model.name(),
+                names.join(", ")
+            )
+        })
     };
     match spec {
         None => Ok((0, if N > 1 { 1 } else { 0 })),

@@ -128,3 +128,103 @@ fn refuses_clearly() {
     let (ok, _, stderr) = dalembert(&["simulate", "pendulum_wall", "--set", "x=0.9"]);
     assert!(!ok && stderr.contains("holonomic"), "{stderr}");
 }
+
+/// A model file of a user's, never compiled: a puck on a round table (its
+/// rim `sqrt`, its radius a derived parameter) cut by a slanted edge (`tan`
+/// of an angle given with `pi`).
+const TABLE: &str = r#"
+[model]
+name = "table"
+doc = "A puck on a round table of radius R cut by the edge y = 1 + x tan(alpha)."
+
+[parameters]
+m = "1"
+a = "1"
+R = { value = "2*a", doc = "the table's radius, derived from a" }
+alpha = "pi/6"
+
+[coordinates]
+names = ["x", "y"]
+
+[dynamics]
+kinetic_energy = "m/2*(x_dot^2 + y_dot^2)"
+
+[[wall]]
+name = "rim"
+surface = "R - sqrt(x^2 + y^2)"
+
+[[wall]]
+name = "edge"
+surface = "1 + tan(alpha)*x - y"
+
+[initial]
+x_dot = "pi/4"
+y_dot = "-1/3"
+"#;
+
+/// Every row of the table's CSV as numbers (the collision column as text).
+fn table_rows(csv: &std::path::Path) -> Vec<(Vec<f64>, String)> {
+    let text = std::fs::read_to_string(csv).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "t,x,y,x_dot,y_dot,energy,residual_velocity,residual_position,collision"
+    );
+    lines
+        .map(|l| {
+            let cells: Vec<&str> = l.split(',').collect();
+            let numbers = cells[..8].iter().map(|x| x.parse().unwrap()).collect();
+            (numbers, cells[8].to_string())
+        })
+        .collect()
+}
+
+#[test]
+fn a_model_file_simulates_without_writing_rust() {
+    let dir = scratch("simulate-table");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("table.toml");
+    std::fs::write(&file, TABLE).unwrap();
+    let (file, out) = (file.to_str().unwrap(), dir.to_str().unwrap());
+    let (ok, stdout, stderr) = dalembert(&["simulate", file, "--t-end", "20", "--out", out]);
+    assert!(ok, "{stdout}\n{stderr}");
+    let rows = table_rows(&dir.join("table.csv"));
+    let tan = (std::f64::consts::PI / 6.0).tan();
+    let speed2 = (std::f64::consts::PI / 4.0).powi(2) + 1.0 / 9.0;
+    let (mut rim, mut edge) = (0, 0);
+    for (r, hit) in &rows {
+        let (x, y) = (r[1], r[2]);
+        assert!(x.hypot(y) <= 2.0 + 1e-9, "off the table: {r:?}");
+        assert!(y <= 1.0 + tan * x + 1e-9, "across the edge: {r:?}");
+        assert!(
+            (r[3] * r[3] + r[4] * r[4] - speed2).abs() < 1e-9,
+            "speed changed: {r:?}"
+        );
+        match hit.as_str() {
+            "rim" => {
+                rim += 1;
+                assert!((x.hypot(y) - 2.0).abs() < 1e-9);
+            }
+            "edge" => {
+                edge += 1;
+                assert!((1.0 + tan * x - y).abs() < 1e-9);
+            }
+            _ => {}
+        }
+    }
+    assert!(rim > 0 && edge > 0, "rim {rim}, edge {edge}");
+    // The derived radius follows its parameter: with a = 3/2 the rim is at 3.
+    let (ok, stdout, stderr) = dalembert(&[
+        "simulate", file, "--t-end", "20", "--set", "a=1.5", "--out", out,
+    ]);
+    assert!(ok, "{stdout}\n{stderr}");
+    let rows = table_rows(&dir.join("table.csv"));
+    let rim: Vec<_> = rows.iter().filter(|(_, hit)| hit == "rim").collect();
+    assert!(!rim.is_empty());
+    for (r, _) in rim {
+        assert!((r[1].hypot(r[2]) - 3.0).abs() < 1e-9, "{r:?}");
+    }
+    // A derived parameter is not set directly.
+    let (ok, _, stderr) = dalembert(&["simulate", file, "--set", "R=5", "--out", out]);
+    assert!(!ok && stderr.contains("derived parameter"), "{stderr}");
+}

@@ -24,6 +24,7 @@
 pub mod derive;
 pub mod diag;
 pub mod emit;
+pub mod interpret;
 pub mod ir;
 pub mod lock;
 pub mod program;

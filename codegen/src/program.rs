@@ -5,6 +5,8 @@
 //! symbolic engine's evaluator optimisation produces it). It does not depend
 //! on the symbolic engine, so the emitter and tests can use it freely.
 
+use std::collections::HashMap;
+
 /// Where a value lives.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Slot {
@@ -179,6 +181,47 @@ impl Program {
         outs
     }
 
+    /// sin and cos of the same value, to be computed together by `sincos` (one
+    /// argument reduction instead of two): for each instruction, the number of
+    /// its pair and whether it comes first. Slots may be reassigned, so a value
+    /// is a slot together with how many times it has been written before.
+    pub fn sincos_pairs(&self) -> Vec<Option<(usize, bool)>> {
+        let mut writes: HashMap<Slot, usize> = HashMap::new();
+        // (source value) → (index of its sin, index of its cos)
+        let mut calls: HashMap<(Slot, usize), (Option<usize>, Option<usize>)> = HashMap::new();
+        for (i, ins) in self.instrs.iter().enumerate() {
+            let dst = match ins {
+                Instr::Add(o, _)
+                | Instr::Mul(o, _)
+                | Instr::Pow(o, _, _)
+                | Instr::Powf(o, _, _)
+                | Instr::Assign(o, _) => *o,
+                Instr::Fun(o, f, src) => {
+                    let value = (*src, writes.get(src).copied().unwrap_or(0));
+                    let entry = calls.entry(value).or_default();
+                    match f {
+                        Func::Sin if entry.0.is_none() => entry.0 = Some(i),
+                        Func::Cos if entry.1.is_none() => entry.1 = Some(i),
+                        _ => {}
+                    }
+                    *o
+                }
+            };
+            *writes.entry(dst).or_default() += 1;
+        }
+        let mut found: Vec<(usize, usize)> = calls
+            .into_values()
+            .filter_map(|(s, c)| Some((s?, c?)))
+            .collect();
+        found.sort_unstable_by_key(|&(s, c)| s.min(c));
+        let mut out = vec![None; self.instrs.len()];
+        for (k, (s, c)) in found.into_iter().enumerate() {
+            out[s] = Some((k, s < c));
+            out[c] = Some((k, c < s));
+        }
+        out
+    }
+
     /// The operations it performs (a power xⁿ counts |n| − 1 multiplications,
     /// and one division when n < 0).
     pub fn op_count(&self) -> OpCount {
@@ -209,5 +252,34 @@ pub fn powf(x: f64, e: f64) -> f64 {
         1.0 / x.sqrt()
     } else {
         x.powf(e)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// sin and cos pair up only when they take the same value: a slot
+    /// written again between them holds a different one.
+    #[test]
+    fn sincos_pairs_follow_values_not_slot_names() {
+        let (x, t) = (Slot::Input(0), Slot::Temp(0));
+        let p = Program {
+            inputs: 1,
+            consts: vec![1.0],
+            instrs: vec![
+                Instr::Add(t, vec![x, Slot::Const(0)]),
+                Instr::Fun(Slot::Out(0), Func::Sin, t),
+                Instr::Add(t, vec![x, x]),
+                Instr::Fun(Slot::Out(1), Func::Cos, t),
+                Instr::Fun(Slot::Out(2), Func::Cos, x),
+                Instr::Fun(Slot::Out(3), Func::Sin, x),
+            ],
+            outputs: 4,
+        };
+        assert_eq!(
+            p.sincos_pairs(),
+            vec![None, None, None, None, Some((0, true)), Some((0, false))]
+        );
     }
 }

@@ -46,8 +46,8 @@ pub extern "C" fn dalembert_nostd_simulate() -> i64 {
     fn run<M: Surfaces<N>, const N: usize>(m: &M) -> i64 {
         let start = State {
             t: 0.0,
-            q: M::INITIAL_COORDINATES,
-            v: M::INITIAL_VELOCITIES,
+            q: m.initial_coordinates(),
+            v: m.initial_velocities(),
         };
         let Ok(mut sim) = Simulator::new(m, start, Settings::default()) else {
             return -1;

@@ -105,11 +105,11 @@ impl<const N: usize> Values<N> {
 }
 
 mod model;
-pub use model::{Dynamics, Model, Surfaces, Walls};
+pub use model::{Dynamics, FromParams, Model, Surfaces, Walls};
 
 /// The model traits, for `use dalembert_runtime::prelude::*`.
 pub mod prelude {
-    pub use crate::{Dynamics, Model, Surfaces, Walls};
+    pub use crate::{Dynamics, FromParams, Model, Surfaces, Walls};
 }
 
 /// What generated code calls besides the traits; not part of the API.

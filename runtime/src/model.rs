@@ -9,24 +9,22 @@ use crate::{Rows, Values, linalg};
 /// What every model has: names, parameters, the mass matrix and the
 /// constraints. `Q` is the number of coordinates (0 for an instantaneous
 /// model) and `N` the number of velocity components.
+///
+/// Names and parameters are methods, not constants, so that a model known
+/// only at run time (the CLI's interpreted model files) has the same traits
+/// as a generated one; a generated model also has them as inherent
+/// constants (`BallFloor::PARAMETERS`).
 pub trait Model<const Q: usize, const N: usize> {
-    /// The model's parameters, with the model file's values as `Default`.
-    type Params: Copy + Default + core::fmt::Debug;
-
     /// The model's name, as in its file.
-    const NAME: &'static str;
+    fn name(&self) -> &str;
     /// Names of the coordinates, in order (empty for an instantaneous model).
-    const COORDINATES: &'static [&'static str];
+    fn coordinate_names(&self) -> &[&str];
     /// Names of the velocity components, in order.
-    const VELOCITIES: &'static [&'static str];
+    fn velocity_names(&self) -> &[&str];
     /// Names of the parameters, in order.
-    const PARAMETERS: &'static [&'static str];
+    fn parameter_names(&self) -> &[&str];
 
-    /// The model with the given parameters.
-    fn with_params(params: Self::Params) -> Self;
-    /// The parameters in use.
-    fn params(&self) -> &Self::Params;
-    /// The value of parameter `index` (in [`Model::PARAMETERS`] order).
+    /// The value of parameter `index` (in [`Model::parameter_names`] order).
     fn parameter(&self, index: usize) -> Option<f64>;
     /// Sets parameter `index`; false when there is no such parameter.
     fn set_parameter(&mut self, index: usize, value: f64) -> bool;
@@ -34,12 +32,12 @@ pub trait Model<const Q: usize, const N: usize> {
     /// (Derived parameters are not parameters of the generated code: they
     /// are computed from the others wherever they are used.)
     fn parameter_named(&self, name: &str) -> Option<f64> {
-        let index = Self::PARAMETERS.iter().position(|p| *p == name)?;
+        let index = self.parameter_names().iter().position(|p| *p == name)?;
         self.parameter(index)
     }
     /// Sets the parameter called `name`; false when the model has none.
     fn set_parameter_named(&mut self, name: &str, value: f64) -> bool {
-        match Self::PARAMETERS.iter().position(|p| *p == name) {
+        match self.parameter_names().iter().position(|p| *p == name) {
             Some(index) => self.set_parameter(index, value),
             None => false,
         }
@@ -55,15 +53,27 @@ pub trait Model<const Q: usize, const N: usize> {
     fn constraints(&self, q: &[f64; Q]) -> Rows<N>;
 }
 
+/// A model built from a parameter struct: what generated models have (an
+/// interpreted model is built from its derivation and has only
+/// [`Model::set_parameter`]).
+pub trait FromParams {
+    /// The model's parameters, with the model file's values as `Default`.
+    type Params: Copy + Default + core::fmt::Debug;
+    /// The model with the given parameters.
+    fn with_params(params: Self::Params) -> Self;
+    /// The parameters in use.
+    fn params(&self) -> &Self::Params;
+}
+
 /// Walls and their collision maps.
 pub trait Walls<const Q: usize, const N: usize>: Model<Q, N> {
-    /// The model's walls, one variant each.
+    /// The model's walls (a generated model has one enum variant each).
     type Wall: Copy + Eq + core::fmt::Debug + 'static;
-    /// Every wall of the model, in file order.
-    const WALLS: &'static [Self::Wall];
 
+    /// Every wall of the model, in file order.
+    fn walls(&self) -> &[Self::Wall];
     /// A wall's name, as in the model file.
-    fn wall_name(wall: Self::Wall) -> &'static str;
+    fn wall_name(&self, wall: Self::Wall) -> &str;
     /// The wall's independent constraint rows B(q); the first is the normal
     /// velocity.
     fn wall_rows(&self, wall: Self::Wall, q: &[f64; Q]) -> Rows<N>;
@@ -95,10 +105,15 @@ pub trait Walls<const Q: usize, const N: usize>: Model<Q, N> {
 /// Lagrange–d'Alembert equations G(q) q̈ + h(q, q̇) = A(q)ᵀλ, A(q) q̇ = 0.
 pub trait Dynamics<const N: usize>: Model<N, N> {
     /// A starting configuration for simulations (the model file's
-    /// `[initial]` table).
-    const INITIAL_COORDINATES: [f64; N] = [0.0; N];
-    /// Starting velocities for simulations (the model file's `[initial]`).
-    const INITIAL_VELOCITIES: [f64; N] = [0.0; N];
+    /// `[initial]` table; zero by default).
+    fn initial_coordinates(&self) -> [f64; N] {
+        [0.0; N]
+    }
+    /// Starting velocities for simulations (the model file's `[initial]`;
+    /// zero by default).
+    fn initial_velocities(&self) -> [f64; N] {
+        [0.0; N]
+    }
 
     /// Potential energy V(q).
     fn potential(&self, q: &[f64; N]) -> f64;

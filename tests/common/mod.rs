@@ -2,7 +2,7 @@
 
 #![allow(dead_code)] // each test binary uses some of these
 
-use dalembert::runtime::{Model, Rows};
+use dalembert::runtime::{FromParams, Model, Rows};
 use nalgebra::DMatrix;
 use proptest::test_runner::{Config, TestCaseError, TestRunner};
 
@@ -36,12 +36,13 @@ pub fn lcg(state: &mut u64) -> f64 {
 /// (each the file's value times a factor in [1/2, 2]), a configuration in
 /// [0.2, 1.4] per coordinate (clear of the Euler angles' singularity at
 /// θ = 0) and velocities in [−3, 3].
-pub fn for_random_cases<M: Model<Q, N>, const Q: usize, const N: usize>(
+pub fn for_random_cases<M: Model<Q, N> + FromParams, const Q: usize, const N: usize>(
     cases: u32,
     check: impl Fn(&M, &[f64; Q], [f64; N]) -> Result<(), TestCaseError>,
 ) {
+    let parameters = M::with_params(Default::default()).parameter_names().len();
     let strategy = (
-        proptest::collection::vec(0.5f64..2.0, M::PARAMETERS.len()),
+        proptest::collection::vec(0.5f64..2.0, parameters),
         proptest::array::uniform::<_, Q>(0.2f64..1.4),
         proptest::array::uniform::<_, N>(-3.0f64..3.0),
     );
@@ -56,7 +57,7 @@ pub fn for_random_cases<M: Model<Q, N>, const Q: usize, const N: usize>(
 }
 
 /// The model with each parameter the file's value times `factors[i]`.
-pub fn scaled<M: Model<Q, N>, const Q: usize, const N: usize>(factors: &[f64]) -> M {
+pub fn scaled<M: Model<Q, N> + FromParams, const Q: usize, const N: usize>(factors: &[f64]) -> M {
     let mut model = M::with_params(Default::default());
     for (i, f) in factors.iter().enumerate() {
         let x = model.parameter(i).unwrap_or(1.0);

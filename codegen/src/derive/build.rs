@@ -2,14 +2,15 @@
 //!
 //! Nothing of the model reaches symbolica as text: symbolica gives some bare
 //! names meanings of its own (`euler_e` is its e, `coeff` and `der` are its
-//! functions), so every model name becomes a symbol in the `dalembert`
-//! namespace, and π and e are symbols of ours that the evaluation pass turns
+//! functions), so every model name becomes a symbol in a namespace of ours
+//! ([`Namespace`]), and π and e are symbols of ours that the evaluation pass turns
 //! into their values. `tan` is built as sin/cos and `sqrt` as a power ½, so
 //! derivatives stay within the functions the emitted code evaluates. Each
 //! division, logarithm and root is checked on the way: an expression that
 //! is undefined everywhere (`1/0`, `y/(x - x)`, `log(0)`, `sqrt(-1)`) is
 //! reported at its place instead of reaching later passes as infinity.
 
+use std::cell::RefCell;
 use std::collections::HashMap;
 use std::ops::Range;
 
@@ -17,17 +18,61 @@ use symbolica::prelude::*;
 
 use crate::ir::{Constant, Function, Node, NodeKind, Rational};
 
+thread_local! {
+    /// The namespace of the symbols made now (see [`Namespace`]).
+    static NAMESPACE: RefCell<String> = RefCell::new("dalembert".into());
+}
+
+/// The namespace every symbol of one derivation is made in, for as long as
+/// the value lives: `dalembert_` and a hash of the model file's text.
+///
+/// symbolica orders the terms of an expression, and so the instructions of
+/// the emitted programs, by when their symbols were made. Symbols made by an
+/// earlier derivation in the same process would otherwise make the
+/// generated code depend on what else the process derived before (a build
+/// script deriving every model, the CLI deriving one). In its own namespace
+/// a model's symbols are made fresh, in the same order every time; the same
+/// text derived again in one process meets the symbols its first derivation
+/// made, in that same order.
+pub struct Namespace {
+    previous: String,
+}
+
+impl Namespace {
+    /// Enters the namespace of the model file with text `source`.
+    pub fn enter(source: &str) -> Self {
+        // FNV-1a: stable across processes and Rust versions.
+        let hash = source.bytes().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
+            (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+        });
+        let previous = NAMESPACE.with(|n| n.replace(format!("dalembert_{hash:016x}")));
+        Self { previous }
+    }
+}
+
+impl Drop for Namespace {
+    fn drop(&mut self) {
+        let previous = std::mem::take(&mut self.previous);
+        NAMESPACE.with(|n| *n.borrow_mut() = previous);
+    }
+}
+
+/// A symbol of ours: `name` in the current namespace.
+pub fn own_symbol(name: &str) -> Symbol {
+    NAMESPACE.with(|ns| symbol!(format!("{}::{name}", ns.borrow()).as_str()))
+}
+
 /// The symbol of a model name.
 pub fn model_symbol(name: &str) -> Symbol {
-    symbol!(format!("dalembert::{name}").as_str())
+    own_symbol(name)
 }
 
 /// The symbol standing for a constant until evaluation (`e` is reserved in
 /// model files and `π` is no identifier, so neither meets a model name).
 pub fn constant_symbol(c: Constant) -> Symbol {
     match c {
-        Constant::Pi => symbol!("dalembert::π"),
-        Constant::E => symbol!("dalembert::e"),
+        Constant::Pi => own_symbol("π"),
+        Constant::E => own_symbol("e"),
     }
 }
 
@@ -80,9 +125,9 @@ pub fn build(node: &Node, definitions: &HashMap<String, Atom>) -> Result<Atom, B
                     if x.is_zero() {
                         return Err(fail("division by zero (the denominator is 0)", &f.span));
                     }
-                    out = out / x;
+                    out /= x;
                 } else {
-                    out = out * x;
+                    out *= x;
                 }
             }
             out

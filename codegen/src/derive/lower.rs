@@ -11,7 +11,7 @@ use std::sync::Arc;
 
 use symbolica::prelude::*;
 
-use super::build::{constant_symbol, own_constants};
+use super::build::{constant_symbol, own_constants, own_symbol};
 use super::mechanics::Raw;
 use super::symbols::Symbols;
 use super::{Rat, is_zero};
@@ -69,7 +69,7 @@ impl Lowering {
                         if seen.contains_key(&key) {
                             continue;
                         }
-                        let s = symbol!(format!("fn__{}", lowered.len()).as_str());
+                        let s = own_symbol(&format!("fn__{}", lowered.len()));
                         seen.insert(key, lowered.len());
                         lowered.push(Lowered {
                             symbol: s,

@@ -44,7 +44,10 @@ type Field = RationalPolynomialField<IntegerRing, u16>;
 pub fn derive(model: &Model) -> Result<Derivation, ModelErrors> {
     let mut cx = Collector::new(&model.file, &model.source);
     let result = match crate::lock::acquire() {
-        Ok(()) => run(model, &mut cx),
+        Ok(()) => {
+            let _namespace = build::Namespace::enter(&model.source);
+            run(model, &mut cx)
+        }
         Err(e) => Err(cx.error(ErrorKind::Symbolic(e), None)),
     };
     cx.conclude(result)

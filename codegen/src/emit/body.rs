@@ -2,8 +2,6 @@
 //! temporaries `t{k}`, outputs `o{k}`; sin and cos of one value computed by
 //! one `sincos` call.
 
-use std::collections::HashMap;
-
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
@@ -51,7 +49,7 @@ pub(super) fn body(d: &Ctx, p: &Program) -> TokenStream {
         let real = real(d);
         quote! { let #name: #real = #value; }
     });
-    let pairs = sincos_pairs(p);
+    let pairs = p.sincos_pairs();
     let stmts = p
         .instrs
         .iter()
@@ -61,47 +59,6 @@ pub(super) fn body(d: &Ctx, p: &Program) -> TokenStream {
             _ => instr(d, p, ins),
         });
     quote! { #(#inputs)* #(#stmts)* }
-}
-
-/// sin and cos of the same value, to be computed together by `sincos` (one
-/// argument reduction instead of two): for each instruction, the number of
-/// its pair and whether it comes first. Slots may be reassigned, so a value
-/// is a slot together with how many times it has been written before.
-fn sincos_pairs(p: &Program) -> Vec<Option<(usize, bool)>> {
-    let mut writes: HashMap<Slot, usize> = HashMap::new();
-    // (source value) → (index of its sin, index of its cos)
-    let mut calls: HashMap<(Slot, usize), (Option<usize>, Option<usize>)> = HashMap::new();
-    for (i, ins) in p.instrs.iter().enumerate() {
-        let dst = match ins {
-            Instr::Add(o, _)
-            | Instr::Mul(o, _)
-            | Instr::Pow(o, _, _)
-            | Instr::Powf(o, _, _)
-            | Instr::Assign(o, _) => *o,
-            Instr::Fun(o, f, src) => {
-                let value = (*src, writes.get(src).copied().unwrap_or(0));
-                let entry = calls.entry(value).or_default();
-                match f {
-                    Func::Sin if entry.0.is_none() => entry.0 = Some(i),
-                    Func::Cos if entry.1.is_none() => entry.1 = Some(i),
-                    _ => {}
-                }
-                *o
-            }
-        };
-        *writes.entry(dst).or_default() += 1;
-    }
-    let mut found: Vec<(usize, usize)> = calls
-        .into_values()
-        .filter_map(|(s, c)| Some((s?, c?)))
-        .collect();
-    found.sort_unstable_by_key(|&(s, c)| s.min(c));
-    let mut out = vec![None; p.instrs.len()];
-    for (k, (s, c)) in found.into_iter().enumerate() {
-        out[s] = Some((k, s < c));
-        out[c] = Some((k, c < s));
-    }
-    out
 }
 
 /// One half of a sin/cos pair: the first computes both into `sc{k}_sin`
@@ -246,34 +203,5 @@ fn powf(d: &Ctx, x: TokenStream, e: f64) -> TokenStream {
         let f = libm_fn(d, "pow");
         let e = lit(d, e);
         quote! { #f(#x, #e) }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// sin and cos pair up only when they take the same value: a slot
-    /// written again between them holds a different one.
-    #[test]
-    fn sincos_pairs_follow_values_not_slot_names() {
-        let (x, t) = (Slot::Input(0), Slot::Temp(0));
-        let p = Program {
-            inputs: 1,
-            consts: vec![1.0],
-            instrs: vec![
-                Instr::Add(t, vec![x, Slot::Const(0)]),
-                Instr::Fun(Slot::Out(0), Func::Sin, t),
-                Instr::Add(t, vec![x, x]),
-                Instr::Fun(Slot::Out(1), Func::Cos, t),
-                Instr::Fun(Slot::Out(2), Func::Cos, x),
-                Instr::Fun(Slot::Out(3), Func::Sin, x),
-            ],
-            outputs: 4,
-        };
-        assert_eq!(
-            sincos_pairs(&p),
-            vec![None, None, None, None, Some((0, true)), Some((0, false))]
-        );
     }
 }

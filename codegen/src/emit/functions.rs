@@ -8,6 +8,7 @@ use quote::{format_ident, quote};
 use super::body::{body, lit, real};
 use super::{Ctx, Scalar, doc_attr, ident};
 use crate::derive::{Function, WallDerivation};
+use crate::ir::camel;
 use crate::program::Program;
 use crate::quantity::Shape;
 
@@ -22,8 +23,23 @@ pub(super) fn inherent_impl(d: &Ctx) -> TokenStream {
     let init_q = d.model.initial[..q].iter().map(|x| lit(d, *x));
     let init_v = d.model.initial[q..].iter().map(|x| lit(d, *x));
     let real = real(d);
+    let name = &d.model.name;
+    let coords = &d.model.coordinates;
+    let vels = &d.model.velocities;
+    let pnames = d.model.params.iter().map(|p| &p.name);
+    let variants = d.walls.iter().map(|w| format_ident!("{}", camel(&w.name)));
     quote! {
         impl #ty {
+            /// The model's name, as in its file.
+            pub const NAME: &'static str = #name;
+            /// Names of the coordinates, in order.
+            pub const COORDINATES: &'static [&'static str] = &[#(#coords),*];
+            /// Names of the velocity components, in order.
+            pub const VELOCITIES: &'static [&'static str] = &[#(#vels),*];
+            /// Names of the parameters, in order (the fields of `Params`).
+            pub const PARAMETERS: &'static [&'static str] = &[#(#pnames),*];
+            /// Every wall, in file order.
+            pub const WALLS: &'static [Wall] = &[#(Wall::#variants),*];
             /// Number of coordinates.
             pub const Q: usize = #qn;
             /// Number of velocity components.

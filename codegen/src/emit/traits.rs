@@ -14,7 +14,6 @@ use crate::quantity::{Capability, Forward, Shape, Spec, TABLE};
 pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
     let ty = format_ident!("{}", d.model.type_name());
     let (q, n) = dims(d);
-    let name = &d.model.name;
     let ql = Literal::usize_unsuffixed(q);
     let nl = Literal::usize_unsuffixed(n);
     let variants: Vec<Ident> = d
@@ -23,11 +22,8 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
         .map(|w| format_ident!("{}", camel(&w.name)))
         .collect();
     let wall_names: Vec<&String> = d.walls.iter().map(|w| &w.name).collect();
-    let pnames: Vec<&String> = d.model.params.iter().map(|p| &p.name).collect();
     let pidents: Vec<Ident> = d.model.params.iter().map(|p| ident(&p.name)).collect();
     let pidx: Vec<Literal> = (0..pidents.len()).map(Literal::usize_unsuffixed).collect();
-    let coords = &d.model.coordinates;
-    let vels = &d.model.velocities;
     let methods = |c: Capability| {
         TABLE
             .iter()
@@ -38,13 +34,10 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
     let (model, walls) = (methods(Capability::Model), methods(Capability::Walls));
     let model_impl = quote! {
         impl ::dalembert_runtime::Model<#ql, #nl> for #ty {
-            type Params = Params;
-            const NAME: &'static str = #name;
-            const COORDINATES: &'static [&'static str] = &[#(#coords),*];
-            const VELOCITIES: &'static [&'static str] = &[#(#vels),*];
-            const PARAMETERS: &'static [&'static str] = &[#(#pnames),*];
-            fn with_params(params: Params) -> Self { Self { params } }
-            fn params(&self) -> &Params { &self.params }
+            fn name(&self) -> &str { Self::NAME }
+            fn coordinate_names(&self) -> &[&str] { Self::COORDINATES }
+            fn velocity_names(&self) -> &[&str] { Self::VELOCITIES }
+            fn parameter_names(&self) -> &[&str] { Self::PARAMETERS }
             fn parameter(&self, index: usize) -> Option<f64> {
                 match index { #(#pidx => Some(self.params.#pidents),)* _ => None }
             }
@@ -53,10 +46,15 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
             }
             #( #model )*
         }
+        impl ::dalembert_runtime::FromParams for #ty {
+            type Params = Params;
+            fn with_params(params: Params) -> Self { Self { params } }
+            fn params(&self) -> &Params { &self.params }
+        }
         impl ::dalembert_runtime::Walls<#ql, #nl> for #ty {
             type Wall = Wall;
-            const WALLS: &'static [Wall] = &[#(Wall::#variants),*];
-            fn wall_name(wall: Wall) -> &'static str {
+            fn walls(&self) -> &[Wall] { Self::WALLS }
+            fn wall_name(&self, wall: Wall) -> &str {
                 match wall { #(Wall::#variants => #wall_names,)* }
             }
             #( #walls )*
@@ -69,8 +67,8 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
     quote! {
         #model_impl
         impl ::dalembert_runtime::Dynamics<#nl> for #ty {
-            const INITIAL_COORDINATES: [f64; #ql] = Self::INITIAL_COORDINATES;
-            const INITIAL_VELOCITIES: [f64; #nl] = Self::INITIAL_VELOCITIES;
+            fn initial_coordinates(&self) -> [f64; #ql] { Self::INITIAL_COORDINATES }
+            fn initial_velocities(&self) -> [f64; #nl] { Self::INITIAL_VELOCITIES }
             #( #dynamics )*
         }
         impl ::dalembert_runtime::Surfaces<#nl> for #ty {

@@ -53,6 +53,23 @@ pub struct BallFloor {
     pub params: Params,
 }
 impl BallFloor {
+    /// The model's name, as in its file.
+    pub const NAME: &'static str = "ball_floor";
+    /// Names of the coordinates, in order.
+    pub const COORDINATES: &'static [&'static str] = &[];
+    /// Names of the velocity components, in order.
+    pub const VELOCITIES: &'static [&'static str] = &[
+        "v1",
+        "v2",
+        "v3",
+        "w1",
+        "w2",
+        "w3",
+    ];
+    /// Names of the parameters, in order (the fields of `Params`).
+    pub const PARAMETERS: &'static [&'static str] = &["m", "r", "J"];
+    /// Every wall, in file order.
+    pub const WALLS: &'static [Wall] = &[Wall::Floor];
     /// Number of coordinates.
     pub const Q: usize = 0;
     /// Number of velocity components.
@@ -317,16 +334,17 @@ impl BallFloor {
     }
 }
 impl ::dalembert_runtime::Model<0, 6> for BallFloor {
-    type Params = Params;
-    const NAME: &'static str = "ball_floor";
-    const COORDINATES: &'static [&'static str] = &[];
-    const VELOCITIES: &'static [&'static str] = &["v1", "v2", "v3", "w1", "w2", "w3"];
-    const PARAMETERS: &'static [&'static str] = &["m", "r", "J"];
-    fn with_params(params: Params) -> Self {
-        Self { params }
+    fn name(&self) -> &str {
+        Self::NAME
     }
-    fn params(&self) -> &Params {
-        &self.params
+    fn coordinate_names(&self) -> &[&str] {
+        Self::COORDINATES
+    }
+    fn velocity_names(&self) -> &[&str] {
+        Self::VELOCITIES
+    }
+    fn parameter_names(&self) -> &[&str] {
+        Self::PARAMETERS
     }
     fn parameter(&self, index: usize) -> Option<f64> {
         match index {
@@ -366,10 +384,21 @@ impl ::dalembert_runtime::Model<0, 6> for BallFloor {
         self.constraints(q)
     }
 }
+impl ::dalembert_runtime::FromParams for BallFloor {
+    type Params = Params;
+    fn with_params(params: Params) -> Self {
+        Self { params }
+    }
+    fn params(&self) -> &Params {
+        &self.params
+    }
+}
 impl ::dalembert_runtime::Walls<0, 6> for BallFloor {
     type Wall = Wall;
-    const WALLS: &'static [Wall] = &[Wall::Floor];
-    fn wall_name(wall: Wall) -> &'static str {
+    fn walls(&self) -> &[Wall] {
+        Self::WALLS
+    }
+    fn wall_name(&self, wall: Wall) -> &str {
         match wall {
             Wall::Floor => "floor",
         }

@@ -58,7 +58,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             f: mut fy,
             t_hi,
         } = located;
-        let wall = M::WALLS[k];
+        let wall = m.walls()[k];
         let reach = TAYLOR_REACH * (t_hi - t0);
         for _ in 0..POLISH_STEPS {
             let f = m.surface(wall, &y.q);
@@ -106,7 +106,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         y: &Phase<N>,
     ) -> Result<Collision<M::Wall, N>, SimError<M::Wall>> {
         let m = self.model;
-        let wall = M::WALLS[k];
+        let wall = m.walls()[k];
         let normal = norm(&m.normal(wall, &y.q));
         let nv = m.normal_velocity(wall, &y.q, &y.v);
         if -nv <= self.settings.grazing * normal * norm(&y.v) {
@@ -123,7 +123,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         }
         // Another wall at or beyond reach within the simultaneity window,
         // moving as after this collision?
-        for (j, &other) in M::WALLS.iter().enumerate() {
+        for (j, &other) in m.walls().iter().enumerate() {
             let rate = m.normal_velocity(other, &y.q, &v_plus).min(0.0);
             if j != k && m.surface(other, &y.q) + self.settings.simultaneous * rate <= 0.0 {
                 return Err(SimError::Simultaneous {

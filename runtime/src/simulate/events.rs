@@ -11,7 +11,7 @@ use crate::{Surfaces, libm, linalg};
 /// A collision predicted from f's second-order Taylor polynomial.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct Aim {
-    /// Index into `M::WALLS`.
+    /// Index into the model's `walls()`.
     pub wall: usize,
     /// How long from now.
     pub tau: f64,
@@ -20,7 +20,7 @@ pub(super) struct Aim {
 /// A wall crossed on a step.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct Crossing {
-    /// Index into `M::WALLS`.
+    /// Index into the model's `walls()`.
     pub wall: usize,
     /// When, on the dense output.
     pub t: f64,
@@ -41,7 +41,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         let m = self.model;
         let shortest = SHORTEST_AIM_ULPS * f64::EPSILON * self.state.t.abs().max(1.0);
         let mut best: Option<Aim> = None;
-        for (k, &wall) in M::WALLS.iter().enumerate() {
+        for (k, &wall) in m.walls().iter().enumerate() {
             let Some(hessian) = m.surface_hessian(wall, &y0.q, &y0.v) else {
                 continue;
             };
@@ -59,7 +59,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         best
     }
 
-    /// The first wall crossed on the step (index into `M::WALLS`, time on
+    /// The first wall crossed on the step (index into the model's `walls()`, time on
     /// the dense output), if any.
     pub(super) fn first_crossing(
         &mut self,
@@ -70,7 +70,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     ) -> Result<Option<Crossing>, SimError<M::Wall>> {
         let mut best: Option<Crossing> = None;
         let mut second: Option<Crossing> = None;
-        for k in 0..M::WALLS.len() {
+        for k in 0..self.model.walls().len() {
             let Some(theta) = self.wall_crossing(k, y0, trial, t0, h)? else {
                 continue;
             };
@@ -94,8 +94,8 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             && b.t - a.t <= self.settings.simultaneous
         {
             return Err(SimError::Simultaneous {
-                first: M::WALLS[a.wall],
-                second: M::WALLS[b.wall],
+                first: self.model.walls()[a.wall],
+                second: self.model.walls()[b.wall],
                 t: a.t,
             });
         }
@@ -120,7 +120,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     ) -> Result<Option<f64>, SimError<M::Wall>> {
         let on = OnStep {
             model: self.model,
-            wall: M::WALLS[k],
+            wall: self.model.walls()[k],
             y0,
             trial,
             h,

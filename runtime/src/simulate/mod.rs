@@ -70,7 +70,7 @@ pub struct Simulator<'m, M: Surfaces<N>, const N: usize> {
     f0: Phase<N>,
     /// The length proposed for the next trial step.
     proposal: f64,
-    /// Walls (bit per index into `M::WALLS`) just collided with and not yet
+    /// Walls (bit per index into the model's `walls()`) just collided with and not yet
     /// left: their f starts at ≈ 0 and must become positive first.
     departing: u64,
     /// When the last collision happened.
@@ -81,7 +81,7 @@ pub struct Simulator<'m, M: Surfaces<N>, const N: usize> {
 /// Where a collision found on a step is polished from.
 #[derive(Clone, Copy, Debug)]
 struct Located<const N: usize> {
-    /// Index into `M::WALLS`.
+    /// Index into the model's `walls()`.
     wall: usize,
     /// A time near the collision, the state there from a real step, and
     /// the derivative there when known.
@@ -119,9 +119,9 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
         {
             return Err(SimError::BadSettings);
         }
-        if M::WALLS.len() > MAX_WALLS {
+        if model.walls().len() > MAX_WALLS {
             return Err(SimError::TooManyWalls {
-                walls: M::WALLS.len(),
+                walls: model.walls().len(),
             });
         }
         let residual = residual(model, &start.q, &start.v);
@@ -137,7 +137,7 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
             return Err(SimError::Inadmissible { residual });
         }
         let mut departing = 0;
-        for (k, &wall) in M::WALLS.iter().enumerate() {
+        for (k, &wall) in model.walls().iter().enumerate() {
             let f = model.surface(wall, &start.q);
             if f <= 0.0 {
                 if f < -ON_WALL * scale || model.normal_velocity(wall, &start.q, &start.v) <= 0.0 {
@@ -221,7 +221,7 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
             // A step aimed at a predicted collision that ends just short of
             // the wall: the collision is a Taylor step ahead.
             None => aim.filter(|a| a.tau == h).and_then(|a| {
-                let wall = M::WALLS[a.wall];
+                let wall = self.model.walls()[a.wall];
                 let f = self.model.surface(wall, &trial.y1.q);
                 let nv = self.model.normal_velocity(wall, &trial.y1.q, &trial.y1.v);
                 let ahead = -f / nv;
@@ -292,7 +292,7 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
 
     /// Forgets walls that the state has left (f > 0).
     fn leave_walls(&mut self) {
-        for (k, &wall) in M::WALLS.iter().enumerate() {
+        for (k, &wall) in self.model.walls().iter().enumerate() {
             if self.departing & (1 << k) != 0 && self.model.surface(wall, &self.state.q) > 0.0 {
                 self.departing &= !(1 << k);
             }

@@ -53,6 +53,23 @@ pub struct BallFloor {
     pub params: Params,
 }
 impl BallFloor {
+    /// The model's name, as in its file.
+    pub const NAME: &'static str = "ball_floor";
+    /// Names of the coordinates, in order.
+    pub const COORDINATES: &'static [&'static str] = &[];
+    /// Names of the velocity components, in order.
+    pub const VELOCITIES: &'static [&'static str] = &[
+        "v1",
+        "v2",
+        "v3",
+        "w1",
+        "w2",
+        "w3",
+    ];
+    /// Names of the parameters, in order (the fields of `Params`).
+    pub const PARAMETERS: &'static [&'static str] = &["m", "r", "J"];
+    /// Every wall, in file order.
+    pub const WALLS: &'static [Wall] = &[Wall::Floor];
     /// Number of coordinates.
     pub const Q: usize = 0;
     /// Number of velocity components.

@@ -80,6 +80,22 @@ pub struct BallWallEuler {
     pub params: Params,
 }
 impl BallWallEuler {
+    /// The model's name, as in its file.
+    pub const NAME: &'static str = "ball_wall_euler";
+    /// Names of the coordinates, in order.
+    pub const COORDINATES: &'static [&'static str] = &["x", "y", "phi", "theta", "psi"];
+    /// Names of the velocity components, in order.
+    pub const VELOCITIES: &'static [&'static str] = &[
+        "x_dot",
+        "y_dot",
+        "phi_dot",
+        "theta_dot",
+        "psi_dot",
+    ];
+    /// Names of the parameters, in order (the fields of `Params`).
+    pub const PARAMETERS: &'static [&'static str] = &["m", "r", "J", "g", "a"];
+    /// Every wall, in file order.
+    pub const WALLS: &'static [Wall] = &[Wall::Wall];
     /// Number of coordinates.
     pub const Q: usize = 5;
     /// Number of velocity components.

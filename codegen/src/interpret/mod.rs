@@ -1,0 +1,400 @@
+//! A derivation run without compiling: the straight-line programs of a
+//! [`Derivation`] evaluated by a small register machine, behind the same
+//! runtime traits as a generated model. It is what lets the CLI simulate a
+//! user's model file at once (`dalembert simulate path/to/model.toml`).
+//!
+//! This is a back end beside [`crate::emit`]: it reads only the plain data
+//! that the derivation hands on (no symbolic engine). Each program runs the
+//! operations the emitted Rust performs, in the same order and with the same
+//! libm functions ([`tape`]), so an interpreted model and its generated
+//! code give the same numbers; `tests/interpreted.rs` checks this for every
+//! built-in model, function by function and over simulated runs.
+
+mod tape;
+
+use std::cell::RefCell;
+
+use dalembert_runtime::{__private, Dynamics, Model, Rows, Surfaces, Values, Walls};
+
+use crate::derive::{Derivation, Function};
+use crate::ir::Kind;
+use crate::quantity::Quantity;
+use tape::Tape;
+
+/// One program with its own register file.
+#[derive(Clone, Debug)]
+struct Compiled {
+    tape: Tape,
+    /// Registers: parameters already in place, the rest filled per call.
+    registers: RefCell<Vec<f64>>,
+    /// For rows and values: how many are in use.
+    rows: usize,
+}
+
+impl Compiled {
+    fn new(f: &Function, params: &[f64]) -> Self {
+        let tape = Tape::new(&f.program);
+        let mut registers = tape.init.clone();
+        let np = params.len().min(tape.inputs);
+        registers[..np].copy_from_slice(&params[..np]);
+        Self {
+            tape,
+            registers: RefCell::new(registers),
+            rows: f.rows,
+        }
+    }
+
+    /// Runs on (parameters, `q`, `v`) and hands the outputs to `read`.
+    fn eval<R>(&self, np: usize, q: &[f64], v: &[f64], read: impl FnOnce(&[f64]) -> R) -> R {
+        let mut r = self.registers.borrow_mut();
+        let inputs = self.tape.inputs;
+        let nq = q.len().min(inputs.saturating_sub(np));
+        r[np..np + nq].copy_from_slice(&q[..nq]);
+        let nv = v.len().min(inputs.saturating_sub(np + nq));
+        r[np + nq..np + nq + nv].copy_from_slice(&v[..nv]);
+        self.tape.run(&mut r);
+        read(self.tape.outputs(&r))
+    }
+
+    fn set_parameter(&mut self, index: usize, value: f64) {
+        let r = self.registers.get_mut();
+        if index < self.tape.inputs {
+            r[index] = value;
+        }
+    }
+}
+
+/// A wall's programs.
+#[derive(Clone, Debug)]
+struct WallPrograms {
+    name: String,
+    surface: Compiled,
+    normal: Compiled,
+    normal_velocity: Compiled,
+    surface_hessian: Compiled,
+    rows: Compiled,
+    /// P and (I − 2P)v in closed form; `None`: solved at run time from G
+    /// and B, as a generated model does.
+    closed_form: Option<(Compiled, Compiled)>,
+}
+
+/// Which wall of an [`Interpreted`] model: its index in file order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct WallIndex(pub usize);
+
+/// A model with `N` coordinates evaluated from its derivation's programs.
+/// Implements [`Model`], [`Walls`], [`Dynamics`] and [`Surfaces`], so the
+/// runtime's simulator and equations of motion take it as they take a
+/// generated model.
+///
+/// Evaluation borrows a register file per program, so the model is not
+/// `Sync`; clone it for another thread.
+#[derive(Clone, Debug)]
+pub struct Interpreted<const N: usize> {
+    name: &'static str,
+    coordinates: &'static [&'static str],
+    velocities: &'static [&'static str],
+    parameters: &'static [&'static str],
+    values: Vec<f64>,
+    initial: ([f64; N], [f64; N]),
+    mass_matrix: Compiled,
+    kinetic_energy: Compiled,
+    potential: Compiled,
+    constraints: Compiled,
+    holonomic: Option<Compiled>,
+    forcing: Compiled,
+    drift: Compiled,
+    accelerations: Option<Compiled>,
+    walls: Vec<WallPrograms>,
+    indices: Vec<WallIndex>,
+}
+
+/// Why a derivation cannot be interpreted with `N` coordinates.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum InterpretError {
+    /// An instantaneous model has no coordinates to move.
+    #[error(
+        "`{0}` is an instantaneous model (velocities at the collision instant only): it has no motion to simulate"
+    )]
+    Instantaneous(String),
+    /// The model's size is not `N`.
+    #[error("`{model}` has {coordinates} coordinates and {velocities} velocities, not {n}")]
+    Size {
+        /// The model.
+        model: String,
+        /// Its coordinates.
+        coordinates: usize,
+        /// Its velocities.
+        velocities: usize,
+        /// What was asked for.
+        n: usize,
+    },
+    /// The derivation lacks a function a model with coordinates has.
+    #[error("the derivation of `{model}` has no `{function}`")]
+    Missing {
+        /// The model.
+        model: String,
+        /// The function.
+        function: &'static str,
+    },
+}
+
+/// Names live as long as the process: an interpreted model is built once
+/// per model file, and the runtime's traits hand out `&[&str]`.
+fn leak_names(names: impl Iterator<Item = String>) -> &'static [&'static str] {
+    let names: Vec<&'static str> = names.map(|n| &*Box::leak(n.into_boxed_str())).collect();
+    Box::leak(names.into_boxed_slice())
+}
+
+impl<const N: usize> Interpreted<N> {
+    /// The model of `d`, with the model file's parameter values.
+    pub fn new(d: &Derivation) -> Result<Self, InterpretError> {
+        let m = &d.model;
+        if m.kind == Kind::Instantaneous {
+            return Err(InterpretError::Instantaneous(m.name.clone()));
+        }
+        if m.coordinates.len() != N || m.velocities.len() != N {
+            return Err(InterpretError::Size {
+                model: m.name.clone(),
+                coordinates: m.coordinates.len(),
+                velocities: m.velocities.len(),
+                n: N,
+            });
+        }
+        let values: Vec<f64> = m.params.iter().map(|p| p.value).collect();
+        let missing = |function| InterpretError::Missing {
+            model: m.name.clone(),
+            function,
+        };
+        let find = |fs: &[Function], q: Quantity| {
+            fs.iter()
+                .find(|f| f.quantity == q)
+                .map(|f| Compiled::new(f, &values))
+        };
+        let model_fn = |q: Quantity| find(&d.functions, q).ok_or_else(|| missing(q.spec().name));
+        let mut walls = Vec::with_capacity(d.walls.len());
+        for w in &d.walls {
+            let wall_fn = |q: Quantity| find(&w.functions, q).ok_or_else(|| missing(q.spec().name));
+            let closed_form = match (
+                find(&w.functions, Quantity::Projector),
+                find(&w.functions, Quantity::Collide),
+            ) {
+                (Some(p), Some(c)) => Some((p, c)),
+                _ => None,
+            };
+            walls.push(WallPrograms {
+                name: w.name.clone(),
+                surface: wall_fn(Quantity::Surface)?,
+                normal: wall_fn(Quantity::Normal)?,
+                normal_velocity: wall_fn(Quantity::NormalVelocity)?,
+                surface_hessian: wall_fn(Quantity::SurfaceHessian)?,
+                rows: wall_fn(Quantity::WallRows)?,
+                closed_form,
+            });
+        }
+        let mut initial = ([0.0; N], [0.0; N]);
+        initial.0.copy_from_slice(&m.initial[..N]);
+        initial.1.copy_from_slice(&m.initial[N..2 * N]);
+        Ok(Self {
+            name: leak_names(std::iter::once(m.name.clone()))[0],
+            coordinates: leak_names(m.coordinates.iter().cloned()),
+            velocities: leak_names(m.velocities.iter().cloned()),
+            parameters: leak_names(m.params.iter().map(|p| p.name.clone())),
+            initial,
+            mass_matrix: model_fn(Quantity::MassMatrix)?,
+            kinetic_energy: model_fn(Quantity::KineticEnergy)?,
+            potential: model_fn(Quantity::Potential)?,
+            constraints: model_fn(Quantity::Constraints)?,
+            holonomic: find(&d.functions, Quantity::Holonomic),
+            forcing: model_fn(Quantity::Forcing)?,
+            drift: model_fn(Quantity::ConstraintDrift)?,
+            accelerations: find(&d.functions, Quantity::Accelerations),
+            indices: (0..walls.len()).map(WallIndex).collect(),
+            walls,
+            values,
+        })
+    }
+
+    /// Sets the starting state the simulator's callers take from
+    /// [`Dynamics::initial_coordinates`] and
+    /// [`Dynamics::initial_velocities`].
+    pub fn set_initial(&mut self, q: [f64; N], v: [f64; N]) {
+        self.initial = (q, v);
+    }
+
+    fn programs_mut(&mut self) -> impl Iterator<Item = &mut Compiled> {
+        let model = [
+            &mut self.mass_matrix,
+            &mut self.kinetic_energy,
+            &mut self.potential,
+            &mut self.constraints,
+            &mut self.forcing,
+            &mut self.drift,
+        ]
+        .into_iter()
+        .chain(self.holonomic.as_mut())
+        .chain(self.accelerations.as_mut());
+        let walls = self.walls.iter_mut().flat_map(|w| {
+            [
+                &mut w.surface,
+                &mut w.normal,
+                &mut w.normal_velocity,
+                &mut w.surface_hessian,
+                &mut w.rows,
+            ]
+            .into_iter()
+            .chain(w.closed_form.as_mut().into_iter().flat_map(|(p, c)| [p, c]))
+        });
+        model.chain(walls)
+    }
+
+    fn np(&self) -> usize {
+        self.values.len()
+    }
+
+    fn scalar(&self, c: &Compiled, q: &[f64; N], v: &[f64]) -> f64 {
+        c.eval(self.np(), q, v, |o| o.first().copied().unwrap_or(0.0))
+    }
+
+    fn vector(&self, c: &Compiled, q: &[f64; N], v: &[f64]) -> [f64; N] {
+        c.eval(self.np(), q, v, |o| {
+            let mut out = [0.0; N];
+            for (x, y) in out.iter_mut().zip(o) {
+                *x = *y;
+            }
+            out
+        })
+    }
+
+    fn matrix(&self, c: &Compiled, q: &[f64; N]) -> [[f64; N]; N] {
+        c.eval(self.np(), q, &[], |o| {
+            core::array::from_fn(|i| {
+                core::array::from_fn(|j| o.get(i * N + j).copied().unwrap_or(0.0))
+            })
+        })
+    }
+
+    fn rows(&self, c: &Compiled, q: &[f64; N]) -> Rows<N> {
+        Rows::new(self.matrix(c, q), c.rows)
+    }
+
+    fn wall(&self, wall: WallIndex) -> &WallPrograms {
+        &self.walls[wall.0]
+    }
+}
+
+impl<const N: usize> Model<N, N> for Interpreted<N> {
+    fn name(&self) -> &str {
+        self.name
+    }
+    fn coordinate_names(&self) -> &[&str] {
+        self.coordinates
+    }
+    fn velocity_names(&self) -> &[&str] {
+        self.velocities
+    }
+    fn parameter_names(&self) -> &[&str] {
+        self.parameters
+    }
+    fn parameter(&self, index: usize) -> Option<f64> {
+        self.values.get(index).copied()
+    }
+    fn set_parameter(&mut self, index: usize, value: f64) -> bool {
+        if index >= self.values.len() {
+            return false;
+        }
+        self.values[index] = value;
+        for c in self.programs_mut() {
+            c.set_parameter(index, value);
+        }
+        true
+    }
+    fn mass_matrix(&self, q: &[f64; N]) -> [[f64; N]; N] {
+        self.matrix(&self.mass_matrix, q)
+    }
+    fn kinetic_energy(&self, q: &[f64; N], v: &[f64; N]) -> f64 {
+        self.scalar(&self.kinetic_energy, q, v)
+    }
+    fn constraints(&self, q: &[f64; N]) -> Rows<N> {
+        self.rows(&self.constraints, q)
+    }
+}
+
+impl<const N: usize> Walls<N, N> for Interpreted<N> {
+    type Wall = WallIndex;
+
+    fn walls(&self) -> &[WallIndex] {
+        &self.indices
+    }
+    fn wall_name(&self, wall: WallIndex) -> &str {
+        &self.wall(wall).name
+    }
+    fn wall_rows(&self, wall: WallIndex, q: &[f64; N]) -> Rows<N> {
+        self.rows(&self.wall(wall).rows, q)
+    }
+    fn projector(&self, wall: WallIndex, q: &[f64; N]) -> [[f64; N]; N] {
+        match &self.wall(wall).closed_form {
+            Some((p, _)) => self.matrix(p, q),
+            None => {
+                let b = self.wall_rows(wall, q);
+                __private::projector(&self.mass_matrix(q), b.as_slice())
+                    .unwrap_or([[f64::NAN; N]; N])
+            }
+        }
+    }
+    fn collide(&self, wall: WallIndex, q: &[f64; N], v: &[f64; N]) -> [f64; N] {
+        match &self.wall(wall).closed_form {
+            Some((_, c)) => self.vector(c, q, v),
+            None => {
+                let b = self.wall_rows(wall, q);
+                let r = b.apply(v);
+                match __private::correction(&self.mass_matrix(q), b.as_slice(), r.as_slice()) {
+                    Ok(d) => core::array::from_fn(|i| v[i] - 2.0 * d[i]),
+                    Err(_) => [f64::NAN; N],
+                }
+            }
+        }
+    }
+    fn normal(&self, wall: WallIndex, q: &[f64; N]) -> [f64; N] {
+        self.vector(&self.wall(wall).normal, q, &[])
+    }
+    fn normal_velocity(&self, wall: WallIndex, q: &[f64; N], v: &[f64; N]) -> f64 {
+        self.scalar(&self.wall(wall).normal_velocity, q, v)
+    }
+}
+
+impl<const N: usize> Dynamics<N> for Interpreted<N> {
+    fn initial_coordinates(&self) -> [f64; N] {
+        self.initial.0
+    }
+    fn initial_velocities(&self) -> [f64; N] {
+        self.initial.1
+    }
+    fn potential(&self, q: &[f64; N]) -> f64 {
+        self.scalar(&self.potential, q, &[])
+    }
+    fn holonomic(&self, q: &[f64; N]) -> Values<N> {
+        match &self.holonomic {
+            Some(c) => Values::new(self.vector(c, q, &[]), c.rows),
+            None => Values::EMPTY,
+        }
+    }
+    fn forcing(&self, q: &[f64; N], v: &[f64; N]) -> [f64; N] {
+        self.vector(&self.forcing, q, v)
+    }
+    fn constraint_drift(&self, q: &[f64; N], v: &[f64; N]) -> [f64; N] {
+        self.vector(&self.drift, q, v)
+    }
+    fn closed_form_accelerations(&self, q: &[f64; N], v: &[f64; N]) -> Option<[f64; N]> {
+        self.accelerations.as_ref().map(|c| self.vector(c, q, v))
+    }
+}
+
+impl<const N: usize> Surfaces<N> for Interpreted<N> {
+    fn surface(&self, wall: WallIndex, q: &[f64; N]) -> f64 {
+        self.scalar(&self.wall(wall).surface, q, &[])
+    }
+    fn surface_hessian(&self, wall: WallIndex, q: &[f64; N], v: &[f64; N]) -> Option<f64> {
+        Some(self.scalar(&self.wall(wall).surface_hessian, q, v))
+    }
+}
