@@ -1,211 +1,311 @@
-//! A [`Program`] made ready to run many times: slots become indices into one
-//! register file (inputs, constants, temporaries, outputs), and every
-//! instruction becomes the operation the emitted Rust performs, in the same
-//! order, with the same libm functions (sin and cos of one value by one
-//! `sincos`, as emitted) — so that the interpreted value and the compiled
-//! one are the same floating-point number.
+//! A [`Program`] made ready to run many times. Every instruction becomes the
+//! operation the emitted Rust performs, in the same form and with the same
+//! libm functions (sin and cos of one value by one `sincos`, as emitted), so
+//! that the interpreted value and the compiled one are the same
+//! floating-point number.
+//!
+//! For speed the operations are not run one by one in program order, where
+//! each would be a hard-to-predict jump on its kind. Every value gets a
+//! register of its own (the program's temporaries are reused slots; here no
+//! register is written twice), each operation gets a level (one more than
+//! the highest level of what it reads), and the operations are run level by
+//! level, all of one kind of a level in one loop. Operations of one level do
+//! not depend on each other, so the order among them cannot change a value.
+//! A copy (`t = o`) costs nothing: the slot just names the value's register.
+
+use std::collections::HashMap;
 
 use dalembert_runtime::libm;
 
 use crate::program::{Func, Instr, Program, Slot};
 
-/// One operation on the register file (destination first).
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Op {
+/// What an operation does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+enum Kind {
     /// a + b
-    Add(u32, u32, u32),
-    /// Σ of `len` registers listed in `args` from `start`, left to right.
-    Sum(u32, u32, u32),
+    Add,
+    /// Σ of `b` registers listed in `args` from `a`, left to right.
+    Sum,
     /// a · b
-    Mul(u32, u32, u32),
-    /// Π of `len` registers listed in `args` from `start`, left to right.
-    Product(u32, u32, u32),
-    /// −x
-    Neg(u32, u32),
-    /// x
-    Copy(u32, u32),
-    /// A constant.
-    Set(u32, f64),
-    /// x · x · … · x (`m` factors, 2 ≤ m ≤ 8), as the emitted code writes
+    Mul,
+    /// Π of `b` registers listed in `args` from `a`, left to right.
+    Product,
+    /// −a
+    Neg,
+    /// The constant x.
+    Set,
+    /// a · a · … · a (`b` factors, 2 ≤ b ≤ 8), as the emitted code writes
     /// small powers.
-    Power(u32, u32, u32),
-    /// libm's pow(x, e).
-    Pow(u32, u32, f64),
-    /// 1 / x
-    Recip(u32, u32),
+    Power,
+    /// libm's pow(a, x).
+    Pow,
+    /// 1 / a
+    Recip,
     /// libm's sqrt.
-    Sqrt(u32, u32),
-    /// 1 / sqrt(x)
-    RecipSqrt(u32, u32),
-    /// libm's sin and cos of x together (sin, cos, x), as the emitted code
-    /// computes a pair.
-    SinCos(u32, u32, u32),
+    Sqrt,
+    /// 1 / sqrt(a)
+    RecipSqrt,
+    /// libm's sincos(a): sin into d, cos into b.
+    SinCos,
     /// libm's sin.
-    Sin(u32, u32),
+    Sin,
     /// libm's cos.
-    Cos(u32, u32),
+    Cos,
     /// libm's exp.
-    Exp(u32, u32),
+    Exp,
     /// libm's log.
-    Log(u32, u32),
+    Log,
+}
+
+/// One operation: destination `d` and operands `a`, `b`, as its kind uses
+/// them (a number, for `Set` and `Pow`, is `numbers[b]`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Op {
+    d: u32,
+    a: u32,
+    b: u32,
+}
+
+/// Operations of one kind and one level: `ops[start..end]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Run {
+    kind: Kind,
+    start: u32,
+    end: u32,
 }
 
 /// A program as register operations.
 #[derive(Clone, Debug)]
 pub(super) struct Tape {
     ops: Vec<Op>,
+    runs: Vec<Run>,
     /// Operands of `Sum` and `Product`.
     args: Vec<u32>,
-    /// The register file before a run: zero inputs, the constants, zero
-    /// temporaries and outputs.
+    /// Numbers of `Set` and `Pow`.
+    numbers: Vec<f64>,
+    /// The register file before a run: zero inputs, the constants, zeros.
     pub(super) init: Vec<f64>,
     /// Number of inputs (registers `0..inputs`).
     pub(super) inputs: usize,
-    /// The first output's register.
+    /// The register holding each output's final value.
+    outputs: Vec<u32>,
+    /// Where the outputs are gathered after a run.
     out_base: usize,
-    /// Number of outputs.
-    outputs: usize,
 }
 
-impl Tape {
-    /// Lays out the registers and translates the instructions.
-    pub(super) fn new(p: &Program) -> Self {
-        let temps = p
-            .instrs
-            .iter()
-            .flat_map(slots)
-            .filter_map(|s| match s {
-                Slot::Temp(i) => Some(i + 1),
-                _ => None,
-            })
-            .max()
-            .unwrap_or(0);
-        let const_base = p.inputs;
-        let temp_base = const_base + p.consts.len();
-        let out_base = temp_base + temps;
-        let pairs = p.sincos_pairs();
-        let npairs = pairs
-            .iter()
-            .flatten()
-            .map(|&(k, _)| k + 1)
-            .max()
-            .unwrap_or(0);
-        let pair_base = out_base + p.outputs;
-        let mut init = vec![0.0; pair_base + 2 * npairs];
-        init[const_base..temp_base].copy_from_slice(&p.consts);
-        let reg = |s: Slot| {
-            (match s {
-                Slot::Input(i) => i,
-                Slot::Const(i) => const_base + i,
-                Slot::Temp(i) => temp_base + i,
-                Slot::Out(i) => out_base + i,
-            }) as u32
-        };
-        let mut t = Self {
-            ops: Vec::with_capacity(p.instrs.len()),
-            args: Vec::new(),
-            init,
-            inputs: p.inputs,
-            out_base,
-            outputs: p.outputs,
-        };
-        for (ins, pair) in p.instrs.iter().zip(pairs) {
-            match (ins, pair) {
-                (Instr::Fun(d, f, x), Some((k, first))) => {
-                    // The pair's sin and cos live in two registers of their own.
-                    let (sin, cos) = ((pair_base + 2 * k) as u32, (pair_base + 2 * k + 1) as u32);
-                    if first {
-                        t.ops.push(Op::SinCos(sin, cos, reg(*x)));
-                    }
-                    let mine = if *f == Func::Sin { sin } else { cos };
-                    t.ops.push(Op::Copy(reg(*d), mine));
-                }
-                _ => t.translate(p, ins, &reg),
-            }
-        }
-        t
+/// The operations in program order while they are being made, with each
+/// register's level.
+struct Builder {
+    ops: Vec<(Kind, Op)>,
+    args: Vec<u32>,
+    numbers: Vec<f64>,
+    level: Vec<u32>,
+    /// The register of each slot's current value.
+    current: HashMap<Slot, u32>,
+    /// A register holding zero (an output never written).
+    zero: u32,
+}
+
+impl Builder {
+    fn read(&self, s: Slot) -> u32 {
+        self.current.get(&s).copied().unwrap_or(self.zero)
     }
 
-    fn translate(&mut self, p: &Program, ins: &Instr, reg: &impl Fn(Slot) -> u32) {
-        match ins {
-            Instr::Add(d, s) => {
-                let s: Vec<u32> = s.iter().map(|&x| reg(x)).collect();
-                self.nary(reg(*d), &s, Op::Add, Op::Sum);
+    /// A new register written by an operation that reads `sources`.
+    fn fresh(&mut self, sources: &[u32]) -> u32 {
+        let level = sources
+            .iter()
+            .map(|&r| self.level[r as usize])
+            .max()
+            .unwrap_or(0)
+            + 1;
+        self.level.push(level);
+        (self.level.len() - 1) as u32
+    }
+
+    fn push(&mut self, kind: Kind, a: u32, b: u32, sources: &[u32]) -> u32 {
+        let d = self.fresh(sources);
+        self.ops.push((kind, Op { d, a, b }));
+        d
+    }
+
+    fn unary(&mut self, kind: Kind, a: u32) -> u32 {
+        self.push(kind, a, 0, &[a])
+    }
+
+    /// An operation of a number (`Set`, `Pow`).
+    fn with_number(&mut self, kind: Kind, a: u32, x: f64, sources: &[u32]) -> u32 {
+        self.numbers.push(x);
+        let b = (self.numbers.len() - 1) as u32;
+        self.push(kind, a, b, sources)
+    }
+
+    /// A sum or product of `operands`: the one itself (no operation), the
+    /// binary kind for two, the listed kind for more.
+    fn nary(&mut self, operands: &[u32], two: Kind, many: Kind) -> u32 {
+        match *operands {
+            [] => self.with_number(Kind::Set, 0, 0.0, &[]),
+            [a] => a,
+            [a, b] => self.push(two, a, b, &[a, b]),
+            _ => {
+                let start = self.args.len() as u32;
+                self.args.extend_from_slice(operands);
+                self.push(many, start, operands.len() as u32, operands)
             }
-            Instr::Mul(d, s) => {
+        }
+    }
+
+    /// The register of `ins`'s value.
+    fn translate(&mut self, p: &Program, ins: &Instr) -> u32 {
+        match ins {
+            Instr::Add(_, s) => {
+                let s: Vec<u32> = s.iter().map(|&x| self.read(x)).collect();
+                self.nary(&s, Kind::Add, Kind::Sum)
+            }
+            Instr::Mul(_, s) => {
                 // As emitted: factors −1 dropped, the product negated when
                 // their number is odd.
                 let minus_one = |x: &Slot| matches!(x, Slot::Const(i) if p.consts[*i] == -1.0);
                 let rest: Vec<u32> = s
                     .iter()
                     .filter(|x| !minus_one(x))
-                    .map(|&x| reg(x))
+                    .map(|&x| self.read(x))
                     .collect();
                 let negate = (s.len() - rest.len()) % 2 == 1;
-                let d = reg(*d);
                 if rest.is_empty() {
-                    self.ops.push(Op::Set(d, if negate { -1.0 } else { 1.0 }));
-                    return;
+                    let one = if negate { -1.0 } else { 1.0 };
+                    return self.with_number(Kind::Set, 0, one, &[]);
                 }
-                self.nary(d, &rest, Op::Mul, Op::Product);
+                let product = self.nary(&rest, Kind::Mul, Kind::Product);
                 if negate {
-                    self.ops.push(Op::Neg(d, d));
-                }
-            }
-            Instr::Pow(d, s, n) => {
-                let (d, s, m) = (reg(*d), reg(*s), n.unsigned_abs());
-                self.ops.push(match m {
-                    0 => Op::Set(d, 1.0),
-                    1 => Op::Copy(d, s),
-                    2..=8 => Op::Power(d, s, m as u32),
-                    _ => Op::Pow(d, s, m as f64),
-                });
-                if *n < 0 {
-                    self.ops.push(Op::Recip(d, d));
-                }
-            }
-            Instr::Powf(d, s, e) => {
-                let (d, s) = (reg(*d), reg(*s));
-                self.ops.push(if *e == 0.5 {
-                    Op::Sqrt(d, s)
-                } else if *e == -0.5 {
-                    Op::RecipSqrt(d, s)
+                    self.unary(Kind::Neg, product)
                 } else {
-                    Op::Pow(d, s, *e)
-                });
+                    product
+                }
             }
-            Instr::Fun(d, f, s) => {
-                let (d, s) = (reg(*d), reg(*s));
-                self.ops.push(match f {
-                    Func::Sin => Op::Sin(d, s),
-                    Func::Cos => Op::Cos(d, s),
-                    Func::Exp => Op::Exp(d, s),
-                    Func::Log => Op::Log(d, s),
-                    Func::Sqrt => Op::Sqrt(d, s),
-                });
+            Instr::Pow(_, s, n) => {
+                let (a, m) = (self.read(*s), n.unsigned_abs());
+                let positive = match m {
+                    0 => self.with_number(Kind::Set, 0, 1.0, &[]),
+                    1 => a,
+                    2..=8 => self.push(Kind::Power, a, m as u32, &[a]),
+                    _ => self.with_number(Kind::Pow, a, m as f64, &[a]),
+                };
+                if *n < 0 {
+                    self.unary(Kind::Recip, positive)
+                } else {
+                    positive
+                }
             }
-            Instr::Assign(d, s) => self.ops.push(Op::Copy(reg(*d), reg(*s))),
+            Instr::Powf(_, s, e) => {
+                let a = self.read(*s);
+                if *e == 0.5 {
+                    self.unary(Kind::Sqrt, a)
+                } else if *e == -0.5 {
+                    self.unary(Kind::RecipSqrt, a)
+                } else {
+                    self.with_number(Kind::Pow, a, *e, &[a])
+                }
+            }
+            Instr::Fun(_, f, s) => {
+                let a = self.read(*s);
+                let kind = match f {
+                    Func::Sin => Kind::Sin,
+                    Func::Cos => Kind::Cos,
+                    Func::Exp => Kind::Exp,
+                    Func::Log => Kind::Log,
+                    Func::Sqrt => Kind::Sqrt,
+                };
+                self.unary(kind, a)
+            }
+            // A copy needs no operation: the slot now names the value's register.
+            Instr::Assign(_, s) => self.read(*s),
         }
     }
+}
 
-    /// A sum or product of `operands`: a copy of one, the binary op for
-    /// two, the listed op for more.
-    fn nary(
-        &mut self,
-        d: u32,
-        operands: &[u32],
-        two: fn(u32, u32, u32) -> Op,
-        many: fn(u32, u32, u32) -> Op,
-    ) {
-        match *operands {
-            [] => self.ops.push(Op::Set(d, 0.0)),
-            [a] => self.ops.push(Op::Copy(d, a)),
-            [a, b] => self.ops.push(two(d, a, b)),
-            _ => {
-                let start = self.args.len() as u32;
-                self.args.extend_from_slice(operands);
-                self.ops.push(many(d, start, operands.len() as u32));
+fn destination(ins: &Instr) -> Slot {
+    match ins {
+        Instr::Add(d, _)
+        | Instr::Mul(d, _)
+        | Instr::Pow(d, _, _)
+        | Instr::Powf(d, _, _)
+        | Instr::Fun(d, _, _)
+        | Instr::Assign(d, _) => *d,
+    }
+}
+
+impl Tape {
+    /// Translates the instructions and orders them by level and kind.
+    pub(super) fn new(p: &Program) -> Self {
+        // Registers: inputs, constants, a zero, then one per value.
+        let zero = (p.inputs + p.consts.len()) as u32;
+        let mut b = Builder {
+            ops: Vec::with_capacity(p.instrs.len()),
+            args: Vec::new(),
+            numbers: Vec::new(),
+            level: vec![0; zero as usize + 1],
+            current: HashMap::new(),
+            zero,
+        };
+        for i in 0..p.inputs {
+            b.current.insert(Slot::Input(i), i as u32);
+        }
+        for k in 0..p.consts.len() {
+            b.current.insert(Slot::Const(k), (p.inputs + k) as u32);
+        }
+        // sin and cos of one value: the first of the pair computes both.
+        let mut pair_registers: HashMap<usize, (u32, u32)> = HashMap::new();
+        for (ins, pair) in p.instrs.iter().zip(p.sincos_pairs()) {
+            let value = match (ins, pair) {
+                (Instr::Fun(_, f, x), Some((k, first))) => {
+                    if first {
+                        let a = b.read(*x);
+                        let sin = b.fresh(&[a]);
+                        let cos = b.fresh(&[a]);
+                        b.ops.push((Kind::SinCos, Op { d: sin, a, b: cos }));
+                        pair_registers.insert(k, (sin, cos));
+                    }
+                    let (sin, cos) = pair_registers[&k];
+                    if *f == Func::Sin { sin } else { cos }
+                }
+                _ => b.translate(p, ins),
+            };
+            b.current.insert(destination(ins), value);
+        }
+        let outputs: Vec<u32> = (0..p.outputs).map(|i| b.read(Slot::Out(i))).collect();
+        // Stable: within a level and kind, program order.
+        let mut ordered = b.ops;
+        ordered.sort_by_key(|(kind, op)| (b.level[op.d as usize], *kind));
+        let mut runs: Vec<Run> = Vec::new();
+        for (i, (kind, op)) in ordered.iter().enumerate() {
+            let level = b.level[op.d as usize];
+            match runs.last_mut() {
+                Some(r)
+                    if r.kind == *kind
+                        && b.level[ordered[r.start as usize].1.d as usize] == level =>
+                {
+                    r.end = i as u32 + 1;
+                }
+                _ => runs.push(Run {
+                    kind: *kind,
+                    start: i as u32,
+                    end: i as u32 + 1,
+                }),
             }
+        }
+        let out_base = b.level.len();
+        let mut init = vec![0.0; out_base + p.outputs];
+        init[p.inputs..zero as usize].copy_from_slice(&p.consts);
+        Self {
+            ops: ordered.into_iter().map(|(_, op)| op).collect(),
+            runs,
+            args: b.args,
+            numbers: b.numbers,
+            init,
+            inputs: p.inputs,
+            outputs,
+            out_base,
         }
     }
 
@@ -213,65 +313,63 @@ impl Tape {
     /// filled in).
     pub(super) fn run(&self, r: &mut [f64]) {
         let at = |i: u32| i as usize;
-        for op in &self.ops {
-            match *op {
-                Op::Add(d, a, b) => r[at(d)] = r[at(a)] + r[at(b)],
-                Op::Sum(d, s, n) => {
-                    let args = &self.args[at(s)..at(s) + at(n)];
+        for run in &self.runs {
+            let ops = &self.ops[at(run.start)..at(run.end)];
+            macro_rules! each {
+                (|$op:ident| $body:expr) => {
+                    for $op in ops {
+                        $body;
+                    }
+                };
+            }
+            match run.kind {
+                Kind::Add => each!(|o| r[at(o.d)] = r[at(o.a)] + r[at(o.b)]),
+                Kind::Mul => each!(|o| r[at(o.d)] = r[at(o.a)] * r[at(o.b)]),
+                Kind::Sum => each!(|o| {
+                    let args = &self.args[at(o.a)..at(o.a) + at(o.b)];
                     let mut acc = r[at(args[0])];
                     for &a in &args[1..] {
                         acc += r[at(a)];
                     }
-                    r[at(d)] = acc;
-                }
-                Op::Mul(d, a, b) => r[at(d)] = r[at(a)] * r[at(b)],
-                Op::Product(d, s, n) => {
-                    let args = &self.args[at(s)..at(s) + at(n)];
+                    r[at(o.d)] = acc
+                }),
+                Kind::Product => each!(|o| {
+                    let args = &self.args[at(o.a)..at(o.a) + at(o.b)];
                     let mut acc = r[at(args[0])];
                     for &a in &args[1..] {
                         acc *= r[at(a)];
                     }
-                    r[at(d)] = acc;
-                }
-                Op::Neg(d, x) => r[at(d)] = -r[at(x)],
-                Op::Copy(d, x) => r[at(d)] = r[at(x)],
-                Op::Set(d, c) => r[at(d)] = c,
-                Op::Power(d, x, m) => {
-                    let x = r[at(x)];
+                    r[at(o.d)] = acc
+                }),
+                Kind::Neg => each!(|o| r[at(o.d)] = -r[at(o.a)]),
+                Kind::Set => each!(|o| r[at(o.d)] = self.numbers[at(o.b)]),
+                Kind::Power => each!(|o| {
+                    let x = r[at(o.a)];
                     let mut acc = x;
-                    for _ in 1..m {
+                    for _ in 1..o.b {
                         acc *= x;
                     }
-                    r[at(d)] = acc;
-                }
-                Op::Pow(d, x, e) => r[at(d)] = libm::pow(r[at(x)], e),
-                Op::Recip(d, x) => r[at(d)] = 1.0 / r[at(x)],
-                Op::Sqrt(d, x) => r[at(d)] = libm::sqrt(r[at(x)]),
-                Op::RecipSqrt(d, x) => r[at(d)] = 1.0 / libm::sqrt(r[at(x)]),
-                Op::SinCos(s, c, x) => (r[at(s)], r[at(c)]) = libm::sincos(r[at(x)]),
-                Op::Sin(d, x) => r[at(d)] = libm::sin(r[at(x)]),
-                Op::Cos(d, x) => r[at(d)] = libm::cos(r[at(x)]),
-                Op::Exp(d, x) => r[at(d)] = libm::exp(r[at(x)]),
-                Op::Log(d, x) => r[at(d)] = libm::log(r[at(x)]),
+                    r[at(o.d)] = acc
+                }),
+                Kind::Pow => each!(|o| r[at(o.d)] = libm::pow(r[at(o.a)], self.numbers[at(o.b)])),
+                Kind::Recip => each!(|o| r[at(o.d)] = 1.0 / r[at(o.a)]),
+                Kind::Sqrt => each!(|o| r[at(o.d)] = libm::sqrt(r[at(o.a)])),
+                Kind::RecipSqrt => each!(|o| r[at(o.d)] = 1.0 / libm::sqrt(r[at(o.a)])),
+                Kind::SinCos => each!(|o| (r[at(o.d)], r[at(o.b)]) = libm::sincos(r[at(o.a)])),
+                Kind::Sin => each!(|o| r[at(o.d)] = libm::sin(r[at(o.a)])),
+                Kind::Cos => each!(|o| r[at(o.d)] = libm::cos(r[at(o.a)])),
+                Kind::Exp => each!(|o| r[at(o.d)] = libm::exp(r[at(o.a)])),
+                Kind::Log => each!(|o| r[at(o.d)] = libm::log(r[at(o.a)])),
             }
+        }
+        for (k, &o) in self.outputs.iter().enumerate() {
+            r[self.out_base + k] = r[at(o)];
         }
     }
 
     /// The outputs in a register file after [`Tape::run`].
     pub(super) fn outputs<'r>(&self, r: &'r [f64]) -> &'r [f64] {
-        &r[self.out_base..self.out_base + self.outputs]
-    }
-}
-
-/// Every slot an instruction reads or writes.
-fn slots(ins: &Instr) -> Vec<Slot> {
-    match ins {
-        Instr::Add(d, s) | Instr::Mul(d, s) => {
-            std::iter::once(*d).chain(s.iter().copied()).collect()
-        }
-        Instr::Pow(d, s, _) | Instr::Powf(d, s, _) | Instr::Fun(d, _, s) | Instr::Assign(d, s) => {
-            vec![*d, *s]
-        }
+        &r[self.out_base..self.out_base + self.outputs.len()]
     }
 }
 
@@ -291,7 +389,7 @@ mod tests {
     /// bit: sums and products left to right, −1 factors as a negation,
     /// small powers as products, large and negative ones through pow and a
     /// reciprocal, ±½ powers as square roots, sin and cos of one value by
-    /// one sincos.
+    /// one sincos; a temporary written twice holds each value in turn.
     #[test]
     fn instructions_match_the_emitted_arithmetic() {
         let (x, y) = (Slot::Input(0), Slot::Input(1));
@@ -311,22 +409,27 @@ mod tests {
                 Instr::Mul(Slot::Out(6), vec![Slot::Const(0), Slot::Const(0)]),
                 Instr::Assign(Slot::Out(7), t0),
                 Instr::Fun(Slot::Out(8), Func::Cos, x),
+                Instr::Add(t0, vec![t0, t1]),
+                Instr::Mul(Slot::Out(9), vec![t0, t0]),
             ],
-            outputs: 9,
+            outputs: 11,
         };
         let (a, b) = (0.7312_f64, 2.25_f64);
         let got = run(&p, &[a, b]);
         let s = a + b + 3.0;
+        let (sin, cos) = libm::sincos(a);
         let want = [
             -(s * b),
             a * a * a * a * a * a * a,
             1.0 / libm::pow(a, 11.0),
             1.0 / libm::sqrt(b),
             libm::pow(b, 1.5),
-            libm::exp(libm::sincos(a).0),
+            libm::exp(sin),
             1.0,
             s,
-            libm::sincos(a).1,
+            cos,
+            (s + sin) * (s + sin),
+            0.0,
         ];
         for (g, w) in got.iter().zip(want) {
             assert_eq!(g.to_bits(), w.to_bits(), "{got:?} vs {want:?}");
