@@ -8,7 +8,7 @@ use indexmap::IndexMap;
 use toml::Spanned;
 
 use super::expr::MAX_DEGREE;
-use super::file::{File, Names, Number, ParamDecl, WallDecl};
+use super::file::{Dynamics, File, Names, Number, ParamDecl, WallDecl};
 use super::number::rational;
 use super::order::{dependency_order, reaches};
 use super::{Expr, GENERATED_TYPE_NAMES, Kind, Model, Param, ProjectorMode, Wall, camel};
@@ -79,6 +79,7 @@ impl Validator<'_> {
             );
         }
         let constraints = dynamics.constraints.iter().map(|c| self.expr(c)).collect();
+        self.constraint_count(&dynamics, velocities.len());
 
         let walls = self.walls(kind, &file.wall);
         let initial = self.initial(&coordinates, &velocities, &file.initial);
@@ -110,6 +111,27 @@ impl Validator<'_> {
             source: self.text.to_string(),
             file: path.to_path_buf(),
         })
+    }
+
+    /// At most N constraint rows (holonomic and velocity ones): A has N
+    /// columns, so more cannot be independent.
+    fn constraint_count(&mut self, dynamics: &Dynamics, velocities: usize) {
+        let rows = dynamics.holonomic.len() + dynamics.constraints.len();
+        if rows <= velocities {
+            return;
+        }
+        let extra = dynamics
+            .holonomic
+            .iter()
+            .chain(&dynamics.constraints)
+            .nth(velocities)
+            .map(|c| c.span());
+        self.cx.error(
+            ErrorKind::Structure(format!(
+                "{rows} constraint rows (holonomic and velocity constraints together) for {velocities} velocities: at most {velocities} can be independent; remove the dependent ones"
+            )),
+            extra,
+        );
     }
 
     /// Parameters: an exact number, a constant expression (`pi/6`), or an
