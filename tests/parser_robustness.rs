@@ -213,6 +213,11 @@ fn mutate(
             prop_assert!(took < limit, "took {took:?} on:\n{text}");
             let mut o = outcomes.borrow_mut();
             o.slowest = o.slowest.max(took);
+            let done = o.rejected + o.generated + o.refused;
+            if derive && done % 10_000 == 0 {
+                // Progress of a long run (a partial run still says something).
+                eprintln!("{done} cases: {o:?}");
+            }
             Ok(())
         })
         .unwrap();

@@ -7,15 +7,17 @@
 //! | [`kinetic_energy_quadratic`]: T = ½ vᵀG v | pass 2, on T |
 //! | [`linear_row`]: a velocity-level constraint is linear and homogeneous in v | pass 2, on each constraint and contact row |
 //! | [`no_velocity`]: V, h and f do not depend on v | pass 2 |
-//! | [`positive_definite`]: G > 0 at the sample point | after the mass matrix's program |
+//! | [`positive_definite`]: G > 0 at the sample point (on h = 0), with a hint where G fails only across h = 0 | after the mass matrix's program |
 //! | [`wall_hypotheses`]: (1.3) ker B ⊆ ker A and ker A ⊄ TN, exactly | per wall, for generic q |
-//! | [`on_wall`]: B of full rank and (1.3) at a point of N itself | per wall with a surface |
+//! | [`on_wall`]: B of full rank and (1.3) at a point of N (and h = 0) itself | per wall with a surface |
 
 use std::ops::Range;
 
 use symbolica::prelude::*;
 
 use super::evaluate::program;
+use super::mechanics::Raw;
+use super::sample::onto;
 use super::symbols::Symbols;
 use super::{Field, Rat, is_zero, rows_matrix};
 use crate::diag::{Collector, ErrorKind, Reported};
@@ -115,24 +117,61 @@ pub fn no_velocity(
     }
 }
 
-/// G positive definite at the sample point (file's parameter values,
-/// [`super::symbols::sample_configuration`]): symmetric, finite, and a
-/// Cholesky factorisation succeeds.
-pub fn positive_definite(sym: &Symbols, cx: &mut Collector, mass_matrix: &Program) {
+/// G positive definite at the sample point (file's parameter values, the
+/// sample configuration on h(q) = 0: [`super::sample::configuration`]):
+/// symmetric, finite, and a Cholesky factorisation succeeds. Where G fails
+/// only across the holonomic constraints (positive on ker dh), the message
+/// says so and how to regularise T.
+pub fn positive_definite(sym: &Symbols, raw: &Raw, cx: &mut Collector, mass_matrix: &Program) {
     let n = sym.vels.len();
-    let vals = mass_matrix.eval(&sym.sample_inputs());
+    let inputs = sym.sample_inputs();
+    let vals = mass_matrix.eval(&inputs);
     let gm = nalgebra::DMatrix::from_row_slice(n, n, &vals);
     let symmetric = (0..n).all(|i| {
         (0..n).all(|j| (gm[(i, j)] - gm[(j, i)]).abs() <= 1e-12 * (1.0 + gm[(i, j)].abs()))
     });
-    if !symmetric || gm.clone().cholesky().is_none() || vals.iter().any(|x| !x.is_finite()) {
-        cx.error(
-            ErrorKind::NotPositiveDefinite {
-                at: sym.sample_description(),
-            },
-            Some(sym.model.kinetic_energy.span.clone()),
-        );
+    if symmetric && vals.iter().all(|x| x.is_finite()) && gm.clone().cholesky().is_some() {
+        return;
     }
+    let hint = match positive_on_constraints(sym, raw, &gm, &inputs) {
+        Some(h) => format!(
+            "; it is positive on the velocities the holonomic constraints allow but not across them, and the equations of motion need G > 0 everywhere: add to T a term that vanishes on them, such as (d/dt h)^2/2 for h = {h}"
+        ),
+        None => String::new(),
+    };
+    cx.error(
+        ErrorKind::NotPositiveDefinite {
+            at: format!("{}{hint}", sym.sample_description()),
+        },
+        Some(sym.model.kinetic_energy.span.clone()),
+    );
+}
+
+/// The first holonomic constraint's text, when G (symmetric, finite) is
+/// positive definite on ker dh: Z G Z + s (I − Z) > 0 with Z the projector
+/// onto ker dh and s a scale of G.
+fn positive_on_constraints(
+    sym: &Symbols,
+    raw: &Raw,
+    gm: &nalgebra::DMatrix<f64>,
+    inputs: &[f64],
+) -> Option<String> {
+    let (n, k) = (gm.nrows(), raw.holonomic.len());
+    if k == 0
+        || !gm.iter().all(|x| x.is_finite())
+        || (gm - gm.transpose()).amax() > 1e-12 * (1.0 + gm.amax())
+    {
+        return None;
+    }
+    let dh: Vec<Atom> = raw.a_rows[..k].iter().flatten().cloned().collect();
+    let rows = program(&dh, &sym.inputs()).ok()?.eval(inputs);
+    let d = nalgebra::DMatrix::from_row_slice(k, n, &rows);
+    let across = d.transpose() * (&d * d.transpose()).lu().try_inverse()? * &d;
+    let z = nalgebra::DMatrix::identity(n, n) - across;
+    let s = 1.0 + gm.amax();
+    let restricted = &z * gm * &z + (nalgebra::DMatrix::identity(n, n) - &z) * s;
+    restricted.cholesky()?;
+    Some(sym.model.holonomic[0].text.clone())
 }
 
 /// (1.3): ker B ⊆ ker A (A's rows lie in B's row space) and ker A ⊄ TN
@@ -184,12 +223,14 @@ pub fn wall_hypotheses(
     }
 }
 
-/// What [`on_wall`] evaluates: f, df and the rows of A and B.
+/// What [`on_wall`] evaluates: f, df, h and the rows of A and B.
 pub struct WallRows<'r> {
     /// f.
     pub surface: &'r Atom,
     /// df.
     pub normal: &'r [Atom],
+    /// The holonomic constraints h (their differentials are A's first rows).
+    pub holonomic: &'r [Atom],
     /// Rows of A.
     pub a: &'r [Vec<Atom>],
     /// Independent rows of B.
@@ -197,13 +238,17 @@ pub struct WallRows<'r> {
 }
 
 /// (1.3) and B's rank at a point of the wall itself: the sample
-/// configuration moved onto N = {f = 0} by Newton steps along ∇f, at the
-/// file's parameter values. Catches models that satisfy the hypotheses for
-/// generic q but break them on N.
+/// configuration moved onto N = {f = 0} and h(q) = 0 by Gauss–Newton steps,
+/// at the file's parameter values. Catches models that satisfy the
+/// hypotheses for generic q but break them on N.
 pub fn on_wall(sym: &Symbols, cx: &mut Collector, w: &Wall, rows: &WallRows) {
     let n = sym.vels.len();
+    let k = rows.holonomic.len();
+    // f, h; df, dh; the rows of A; the rows of B.
     let mut outputs = vec![rows.surface.clone()];
+    outputs.extend(rows.holonomic.iter().cloned());
     outputs.extend(rows.normal.iter().cloned());
+    outputs.extend(rows.a[..k].iter().flatten().cloned());
     outputs.extend(rows.a.iter().flatten().cloned());
     outputs.extend(rows.b.iter().flatten().cloned());
     let prog = match program(&outputs, &sym.inputs()) {
@@ -214,7 +259,7 @@ pub fn on_wall(sym: &Symbols, cx: &mut Collector, w: &Wall, rows: &WallRows) {
         }
     };
     let np = sym.params.len();
-    let Some(x) = point_on_wall(&prog, sym.sample_inputs(), np, n) else {
+    let Some(x) = onto(&prog, sym.sample_inputs(), np, n, 1 + k) else {
         // No point of N found near the sample: the generic checks stand.
         return;
     };
@@ -222,9 +267,11 @@ pub fn on_wall(sym: &Symbols, cx: &mut Collector, w: &Wall, rows: &WallRows) {
     let matrix = |from: usize, count: usize| -> nalgebra::DMatrix<f64> {
         nalgebra::DMatrix::from_fn(count, n, |i, j| out[from + i * n + j])
     };
-    let normal_m = matrix(1, 1);
-    let a_m = matrix(1 + n, rows.a.len());
-    let b_m = matrix(1 + n + rows.a.len() * n, rows.b.len());
+    let gradients = 1 + k;
+    let normal_m = matrix(gradients, 1);
+    let a_from = gradients + gradients * n;
+    let a_m = matrix(a_from, rows.a.len());
+    let b_m = matrix(a_from + rows.a.len() * n, rows.b.len());
     let at = format!(
         "the point {} of the wall",
         sym.point_description(&x[np..np + n])
@@ -250,29 +297,6 @@ pub fn on_wall(sym: &Symbols, cx: &mut Collector, w: &Wall, rows: &WallRows) {
             Some(w.span.clone()),
         );
     }
-}
-
-/// The inputs `x` moved onto f = 0 (the program's first output, its
-/// gradient the next `n`) by Newton steps in the coordinates, which follow
-/// the `np` parameters.
-fn point_on_wall(prog: &Program, mut x: Vec<f64>, np: usize, n: usize) -> Option<Vec<f64>> {
-    for _ in 0..100 {
-        let out = prog.eval(&x);
-        let f = out[0];
-        let grad = &out[1..1 + n];
-        let g2: f64 = grad.iter().map(|g| g * g).sum();
-        let scale = 1.0 + x[np..np + n].iter().fold(0.0_f64, |m, q| m.max(q.abs()));
-        if f.abs() <= 1e-12 * scale {
-            return Some(x);
-        }
-        if g2.is_nan() || g2 <= 0.0 || !f.is_finite() {
-            return None;
-        }
-        for k in 0..n {
-            x[np + k] -= f * grad[k] / g2;
-        }
-    }
-    None
 }
 
 /// The rows of `p` above those of `q`.

@@ -22,6 +22,7 @@ pub mod inspect;
 mod lower;
 mod mechanics;
 mod output;
+mod sample;
 mod symbols;
 mod walls;
 
@@ -55,8 +56,9 @@ pub fn derive(model: &Model) -> Result<Derivation, ModelErrors> {
 
 /// The passes in order.
 fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
-    let sym = symbols::Symbols::new(model, cx)?;
+    let mut sym = symbols::Symbols::new(model, cx)?;
     let raw = mechanics::raw(&sym, cx)?;
+    sym.sample = sample::configuration(&sym, &raw);
     let low = lower::Lowering::new(&sym, &raw);
     let exact = mechanics::exact(&sym, &low, &raw, cx)?;
     let compile = Compiler {
@@ -66,7 +68,7 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
     let t_span = &model.kinetic_energy.span;
     let g_flat: Vec<Atom> = exact.g.iter().flatten().cloned().collect();
     let mass_matrix = compile.program(cx, Quantity::MassMatrix, &g_flat, 0, t_span)?;
-    checks::positive_definite(&sym, cx, &mass_matrix.program);
+    checks::positive_definite(&sym, &raw, cx, &mass_matrix.program);
     let g_inv = exact.inverse(&sym, cx)?;
     let context = walls::Context {
         sym: &sym,

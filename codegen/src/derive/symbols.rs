@@ -22,6 +22,10 @@ pub struct Symbols<'a> {
     pub vels: Vec<Symbol>,
     /// Each definition, free of the others.
     definitions: HashMap<String, Atom>,
+    /// Where the numeric checks evaluate: [`sample_configuration`], moved
+    /// onto h(q) = 0 once the constraints are known
+    /// ([`super::sample::configuration`]).
+    pub sample: Vec<f64>,
 }
 
 impl<'a> Symbols<'a> {
@@ -40,12 +44,14 @@ impl<'a> Symbols<'a> {
             let a = build_in(e, &definitions, cx)?;
             definitions.insert(name.clone(), a);
         }
+        let sample = sample_configuration(coords.len());
         Ok(Self {
             model,
             params,
             coords,
             vels,
             definitions,
+            sample,
         })
     }
 
@@ -71,18 +77,18 @@ impl<'a> Symbols<'a> {
             .collect()
     }
 
-    /// The inputs at the sample point: the file's parameter values,
-    /// [`sample_configuration`], zero velocities.
+    /// The inputs at the sample point: the file's parameter values, the
+    /// sample configuration, zero velocities.
     pub fn sample_inputs(&self) -> Vec<f64> {
         let mut v: Vec<f64> = self.model.params.iter().map(|p| p.value).collect();
-        v.extend(sample_configuration(self.coords.len()));
+        v.extend(&self.sample);
         v.extend(std::iter::repeat_n(0.0, self.vels.len()));
         v
     }
 
     /// The sample point, described for people.
     pub fn sample_description(&self) -> String {
-        self.point_description(&sample_configuration(self.coords.len()))
+        self.point_description(&self.sample)
     }
 
     /// "m = 1, r = 1/2, x = 0.3, …": the file's parameter values and `q`.

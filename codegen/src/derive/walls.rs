@@ -176,6 +176,7 @@ fn rows(
         let rows = WallRows {
             surface: &raw.surface,
             normal: &raw.normal,
+            holonomic: &c.raw.holonomic,
             a: &c.raw.a_rows,
             b: &atoms,
         };

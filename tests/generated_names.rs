@@ -1,0 +1,230 @@
+//! If `generate` succeeds, the file compiles: model files with random names
+//! (Rust keywords, the generated code's own names, names that differ only in
+//! case or underscores, ordinary ones) are generated, and every file that
+//! generates is compiled against the runtime by rustc in one crate. Uses the
+//! symbolic engine: run one test at a time (`RUST_TEST_THREADS=1`).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use proptest::prelude::*;
+use proptest::test_runner::{Config, TestRunner};
+
+/// Names that mean something to Rust, to the generated file or to the
+/// runtime, and near-collisions of each other.
+const TRICKY: &[&str] = &[
+    "type",
+    "fn",
+    "match",
+    "self",
+    "Self",
+    "crate",
+    "super",
+    "async",
+    "dyn",
+    "union",
+    "mod",
+    "r#x",
+    "Params",
+    "params",
+    "Wall",
+    "wall",
+    "Walls",
+    "Option",
+    "Some",
+    "None",
+    "Ok",
+    "Err",
+    "Default",
+    "default",
+    "Result",
+    "Vec",
+    "String",
+    "f64",
+    "f32",
+    "usize",
+    "core",
+    "std",
+    "Rows",
+    "Values",
+    "Model",
+    "Dynamics",
+    "Surfaces",
+    "FromParams",
+    "libm",
+    "sin",
+    "cos",
+    "sqrt",
+    "o0",
+    "t0",
+    "i0",
+    "sc0_sin",
+    "q",
+    "v",
+    "new",
+    "with_params",
+    "NAME",
+    "WALLS",
+    "Q",
+    "N",
+    "a1",
+    "a_1",
+    "A1",
+    "floor",
+    "Floor",
+    "x_dot",
+    "x",
+    "e",
+    "pi",
+    "euler_e",
+    "coeff",
+    "der",
+    "abs",
+    "Rational",
+    "main",
+    "_",
+    "_x",
+    "x_",
+    "__",
+    "mass_matrix",
+    "collide",
+];
+
+/// Mostly ordinary names (`first` gives their first character), one in
+/// six from [`TRICKY`].
+fn name(first: &'static str) -> impl Strategy<Value = String> {
+    prop_oneof![
+        1 => (0..TRICKY.len()).prop_map(|i| TRICKY[i].to_string()),
+        5 => proptest::string::string_regex(&format!("{first}[a-z0-9]{{0,3}}(_[a-z0-9]{{1,2}})?"))
+            .unwrap(),
+    ]
+}
+
+/// A small model file with the given names (duplicates and bad names are
+/// the validator's to refuse).
+fn model(
+    model: &str,
+    params: &[String],
+    coords: &[String],
+    walls: &[String],
+    definition: &str,
+) -> String {
+    let params_toml: String = params.iter().map(|p| format!("{p} = \"2\"\n")).collect();
+    let mass = params.first().cloned().unwrap_or_else(|| "1".into());
+    let t: Vec<String> = coords
+        .iter()
+        .map(|c| format!("{mass}*{c}_dot^2/2"))
+        .collect();
+    let coord_list: Vec<String> = coords.iter().map(|c| format!("\"{c}\"")).collect();
+    let walls_toml: String = walls
+        .iter()
+        .map(|w| {
+            format!(
+                "[[wall]]\nname = \"{w}\"\nsurface = \"{} + {definition}\"\n",
+                coords[0]
+            )
+        })
+        .collect();
+    format!(
+        "[model]\nname = \"{model}\"\n[parameters]\n{params_toml}[definitions]\n{definition} = \"3\"\n[coordinates]\nnames = [{}]\n[dynamics]\nkinetic_energy = \"{}\"\npotential = \"{mass}*{}\"\n{walls_toml}",
+        coord_list.join(", "),
+        t.join(" + "),
+        coords[0],
+    )
+}
+
+/// The runtime's rlib next to this test binary (the newest, if several).
+fn runtime_rlib(deps: &Path) -> PathBuf {
+    std::fs::read_dir(deps)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            let name = p.file_name().unwrap().to_string_lossy().into_owned();
+            name.starts_with("libdalembert_runtime-") && name.ends_with(".rlib")
+        })
+        .max_by_key(|p| p.metadata().unwrap().modified().unwrap())
+        .expect("the runtime's rlib is built before the tests")
+}
+
+#[test]
+fn every_generated_file_compiles() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("generated-names");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut runner = TestRunner::new(Config {
+        cases: 400,
+        failure_persistence: None,
+        ..Config::default()
+    });
+    let strategy = (
+        name("[a-z]"),
+        proptest::collection::vec(name("[a-zA-Z]"), 1..3),
+        proptest::collection::vec(name("[a-zA-Z]"), 1..3),
+        proptest::collection::vec(name("[a-z]"), 1..3),
+        name("[a-zA-Z]"),
+    );
+    let generated = std::cell::RefCell::new(Vec::<(String, String)>::new());
+    let refused = std::cell::Cell::new(0);
+    runner
+        .run(&strategy, |(m, params, coords, walls, definition)| {
+            let text = model(&m, &params, &coords, &walls, &definition);
+            let k = generated.borrow().len() + refused.get();
+            let file = dir.join(format!("case{k}.toml"));
+            std::fs::write(&file, &text).unwrap();
+            match dalembert_codegen::generate(&file) {
+                Ok(code) => generated.borrow_mut().push((text, code)),
+                Err(_) => refused.set(refused.get() + 1),
+            }
+            Ok(())
+        })
+        .unwrap();
+    let generated = generated.into_inner();
+    assert!(
+        generated.len() >= 30 && refused.get() >= 30,
+        "{} generated, {} refused: the names should give both",
+        generated.len(),
+        refused.get()
+    );
+    // One crate, a module per generated file.
+    let mut lib = String::from("#![allow(dead_code)]\n");
+    for (k, (_, code)) in generated.iter().enumerate() {
+        std::fs::write(dir.join(format!("m{k}.rs")), code).unwrap();
+        lib.push_str(&format!("#[path = \"m{k}.rs\"]\npub mod m{k};\n"));
+    }
+    std::fs::write(dir.join("lib.rs"), lib).unwrap();
+    let deps = std::env::current_exe()
+        .unwrap()
+        .parent()
+        .unwrap()
+        .to_path_buf();
+    let out = Command::new(std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into()))
+        .args([
+            "--edition",
+            "2024",
+            "--crate-type",
+            "lib",
+            "--crate-name",
+            "generated_names",
+        ])
+        .arg("-L")
+        .arg(format!("dependency={}", deps.display()))
+        .arg("--extern")
+        .arg(format!(
+            "dalembert_runtime={}",
+            runtime_rlib(&deps).display()
+        ))
+        .arg("--out-dir")
+        .arg(&dir)
+        .arg(dir.join("lib.rs"))
+        .output()
+        .expect("rustc runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success() {
+        // Name the first model file whose module has an error.
+        let first = (0..generated.len())
+            .find(|k| stderr.contains(&format!("m{k}.rs")))
+            .map(|k| generated[k].0.clone())
+            .unwrap_or_default();
+        panic!("a generated file does not compile:\n{first}\n\n{stderr}");
+    }
+}
