@@ -7,6 +7,7 @@
 
 pub mod expr;
 mod file;
+mod limits;
 mod names;
 mod number;
 mod order;

@@ -8,7 +8,8 @@ use indexmap::IndexMap;
 use toml::Spanned;
 
 use super::expr::MAX_DEGREE;
-use super::file::{Dynamics, File, Names, Number, ParamDecl, WallDecl};
+use super::file::{File, Names, Number, ParamDecl, WallDecl};
+use super::limits::{self, MAX_DEFINITIONS, MAX_EXPANDED_SIZE};
 use super::number::rational;
 use super::order::{dependency_order, reaches};
 use super::{Expr, GENERATED_TYPE_NAMES, Kind, Model, Param, ProjectorMode, Wall, camel};
@@ -79,7 +80,7 @@ impl Validator<'_> {
             );
         }
         let constraints = dynamics.constraints.iter().map(|c| self.expr(c)).collect();
-        self.constraint_count(&dynamics, velocities.len());
+        limits::constraint_count(self.cx, &dynamics, velocities.len());
 
         let walls = self.walls(kind, &file.wall);
         let initial = self.initial(&coordinates, &velocities, &file.initial);
@@ -111,27 +112,6 @@ impl Validator<'_> {
             source: self.text.to_string(),
             file: path.to_path_buf(),
         })
-    }
-
-    /// At most N constraint rows (holonomic and velocity ones): A has N
-    /// columns, so more cannot be independent.
-    fn constraint_count(&mut self, dynamics: &Dynamics, velocities: usize) {
-        let rows = dynamics.holonomic.len() + dynamics.constraints.len();
-        if rows <= velocities {
-            return;
-        }
-        let extra = dynamics
-            .holonomic
-            .iter()
-            .chain(&dynamics.constraints)
-            .nth(velocities)
-            .map(|c| c.span());
-        self.cx.error(
-            ErrorKind::Structure(format!(
-                "{rows} constraint rows (holonomic and velocity constraints together) for {velocities} velocities: at most {velocities} can be independent; remove the dependent ones"
-            )),
-            extra,
-        );
     }
 
     /// Parameters: an exact number, a constant expression (`pi/6`), or an
@@ -207,8 +187,14 @@ impl Validator<'_> {
         vels: Option<&Spanned<Names>>,
     ) -> (Kind, Vec<String>, Vec<String>) {
         match (coords, vels) {
-            (Some(c), None) => self.coordinates(c),
-            (None, Some(v)) => self.instantaneous(v),
+            (Some(c), None) => {
+                limits::variable_count(self.cx, c.get_ref().names.len(), c.span());
+                self.coordinates(c)
+            }
+            (None, Some(v)) => {
+                limits::variable_count(self.cx, v.get_ref().names.len(), v.span());
+                self.instantaneous(v)
+            }
             (Some(c), Some(_)) => {
                 self.cx.error(
                     ErrorKind::Structure(
@@ -592,9 +578,3 @@ impl Validator<'_> {
         }
     }
 }
-
-/// Most definitions a model may have.
-const MAX_DEFINITIONS: usize = 1000;
-/// Largest size (in nodes) of a definition once the definitions it uses are
-/// substituted.
-const MAX_EXPANDED_SIZE: u64 = 200_000;
