@@ -455,6 +455,63 @@ fn two_masses_in_a_box_follow_the_textbook_event_by_event() {
     assert!(events > 50, "only {events} events");
 }
 
+/// The same box at every scale: lengths times 1e-12 or 1e12, speeds times
+/// 1e12 or 1e-3, the same walls are met in the same order at the same
+/// instants in units of length/speed. (A contact window in absolute time
+/// made the small box "simultaneous" at its first collision.)
+#[test]
+fn the_box_is_the_same_box_at_every_scale() {
+    use dalembert::models::masses_on_line::{Params, Wall};
+    let events = |len: f64, speed: f64| -> Vec<(Wall, f64)> {
+        let sys = MassesOnLine::with_params(Params {
+            L: len,
+            ..Params::default()
+        });
+        let start = State {
+            t: 0.0,
+            q: [0.2 * len, 0.6 * len],
+            v: [speed, -0.5 * speed],
+        };
+        let mut settings = dormand_prince(1e-10);
+        if let Integrator::DormandPrince(dp) = &mut settings.integrator {
+            dp.atol = 1e-14 * len.min(speed);
+        }
+        let unit = len / speed;
+        let mut sim = Simulator::new(&sys, start, settings).unwrap();
+        let mut seen = Vec::new();
+        // Events are compared up to 39.5 units, short of the run's end, so
+        // that one landing at the very end of one run and just after the end
+        // of another is not counted (no event is near 39.5).
+        sim.run(40.0 * unit, |s| {
+            if let Some(c) = s.collision.filter(|c| c.t < 39.5 * unit) {
+                seen.push((c.wall, c.t / unit));
+            }
+            true
+        })
+        .unwrap_or_else(|e| panic!("length {len:e}, speed {speed:e}: {e}"));
+        seen
+    };
+    let reference = events(1.0, 1.0);
+    assert!(reference.len() > 50, "only {} events", reference.len());
+    for (len, speed) in [(1e-12, 1.0), (1.0, 1e12), (1e12, 1e-3), (1e-12, 1e-12)] {
+        let scaled = events(len, speed);
+        assert_eq!(
+            scaled.len(),
+            reference.len(),
+            "length {len:e}, speed {speed:e}"
+        );
+        for (k, (a, b)) in reference.iter().zip(&scaled).enumerate() {
+            assert_eq!(a.0, b.0, "event {k}, length {len:e}, speed {speed:e}");
+            assert!(
+                (a.1 - b.1).abs() <= 1e-9 * (1.0 + a.1),
+                "event {k}, length {len:e}, speed {speed:e}: {} vs {}",
+                a.1,
+                b.1
+            );
+        }
+    }
+}
+
 // ------------------------------------------------------------ reported, not resolved
 
 #[test]

@@ -18,8 +18,10 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         located: Located<N>,
     ) -> Result<Collision<M::Wall, N>, SimError<M::Wall>> {
         let k = located.wall;
+        let step = located.t_hi - t0;
         let (tc, y) = self.polish(y0, t0, located)?;
-        let collision = self.resolve(k, tc, &y)?;
+        let window = self.simultaneity_window(tc, step);
+        let collision = self.resolve(k, tc, &y, window)?;
         self.state = State {
             t: tc,
             q: y.q,
@@ -98,12 +100,13 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
 
     /// The collision with wall `k` at (tc, y): refused when grazing, when
     /// the map does not reverse the normal velocity (B loses rank there) or
-    /// when another wall is met at the same time.
+    /// when another wall is met within `window` of tc.
     fn resolve(
         &self,
         k: usize,
         tc: f64,
         y: &Phase<N>,
+        window: f64,
     ) -> Result<Collision<M::Wall, N>, SimError<M::Wall>> {
         let m = self.model;
         let wall = m.walls()[k];
@@ -121,11 +124,11 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         if !v_plus.iter().all(|x| x.is_finite()) || (nv_plus + nv).abs() > REVERSAL * nv.abs() {
             return Err(SimError::SingularWall { wall, t: tc });
         }
-        // Another wall at or beyond reach within the simultaneity window,
-        // moving as after this collision?
+        // Another wall at or beyond reach within the window, moving as after
+        // this collision?
         for (j, &other) in m.walls().iter().enumerate() {
             let rate = m.normal_velocity(other, &y.q, &v_plus).min(0.0);
-            if j != k && m.surface(other, &y.q) + self.settings.simultaneous * rate <= 0.0 {
+            if j != k && m.surface(other, &y.q) + window * rate <= 0.0 {
                 return Err(SimError::Simultaneous {
                     first: wall,
                     second: other,

@@ -22,8 +22,8 @@
 //! so no step across the wall has to be redone; elsewhere the prediction
 //! only shortens a step and the crossing is found as above.
 //!
-//! Nothing is silently wrong: two walls met within
-//! [`Settings::simultaneous`] of each other, a contact whose normal velocity
+//! Nothing is silently wrong: two walls met within a fraction
+//! [`Settings::simultaneous`] of a step of each other, a contact whose normal velocity
 //! is too small to tell whether the wall is met ([`Settings::grazing`]), a
 //! collision map that does not reverse the normal velocity (a configuration
 //! where B loses rank), non-finite states and singular mass matrices are all
@@ -115,7 +115,7 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
     ) -> Result<Self, SimError<M::Wall>> {
         if !settings.integrator.valid()
             || settings.grazing.is_nan()
-            || settings.simultaneous.is_nan()
+            || !(settings.simultaneous >= 0.0 && settings.simultaneous < 1.0)
         {
             return Err(SimError::BadSettings);
         }

@@ -52,3 +52,8 @@ pub const HOLONOMIC_FAILED: f64 = 1e-10;
 
 /// Iterations at most of the Illinois root finder on the dense output.
 pub const ROOT_ITERATIONS: usize = 200;
+
+/// Two crossings at most this many ulps of t apart are simultaneous
+/// whatever the step (see [`super::Settings::simultaneous`]): equal instants
+/// computed by different roundings differ by about this much.
+pub const SIMULTANEOUS_ULPS: f64 = 4.0;

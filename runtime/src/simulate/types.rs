@@ -15,8 +15,12 @@ pub struct Settings {
     /// A contact is *grazing* when |df·v| ≤ grazing · |df| · |v| there; it is
     /// reported as [`SimError::Grazing`] rather than resolved.
     pub grazing: f64,
-    /// Two walls met less than this much time apart are reported as
-    /// [`SimError::Simultaneous`]: the paper's law is for one wall at a time.
+    /// Two walls met less than this fraction of the step that finds them
+    /// apart (and at least [`SIMULTANEOUS_ULPS`](super::thresholds::SIMULTANEOUS_ULPS)
+    /// ulps of t) are reported as [`SimError::Simultaneous`]: the paper's
+    /// law is for one wall at a time. Relative to the step, so that the
+    /// judgement does not change when lengths or times are rescaled: a box
+    /// 1e-12 wide is the same box as one 1 wide, seen faster.
     pub simultaneous: f64,
     /// Points per step (besides its ends) at which each wall's f is sampled
     /// for sign changes on the dense output.
@@ -124,7 +128,8 @@ pub enum SimError<W> {
         /// f(q).
         surface: f64,
     },
-    /// Two walls are met within [`Settings::simultaneous`] of each other.
+    /// Two walls are met within a fraction [`Settings::simultaneous`] of a
+    /// step of each other.
     Simultaneous {
         /// The wall met first.
         first: W,
