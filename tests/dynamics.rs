@@ -214,3 +214,23 @@ fn qdd_uses_the_closed_form_and_falls_back() {
         }
     }
 }
+
+/// The starting state of `[initial]` is a function of the parameters: the
+/// §3.2.1 ball starts on the floor (`z = "r"`) at any radius; the inherent
+/// constant keeps the file's values.
+#[test]
+fn the_initial_state_follows_the_parameters() {
+    use dalembert::models::ball_bounce::Params;
+    for r in [0.5, 1.0, 0.125] {
+        let ball = BallBounce::with_params(Params {
+            r,
+            ..Params::default()
+        });
+        let q = ball.initial_coordinates();
+        assert_eq!(q[2], r);
+        assert_eq!(q[4], std::f64::consts::FRAC_PI_2);
+        assert_eq!(ball.initial_velocities(), [1.0, 0.0, 2.0, 0.0, 0.0, 5.0]);
+        assert_eq!(ball.surface(ball_bounce::Wall::Floor, &q), 0.0);
+    }
+    assert_eq!(BallBounce::INITIAL_COORDINATES[2], 0.5);
+}

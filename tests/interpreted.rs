@@ -97,6 +97,16 @@ fn same_functions<M: Surfaces<N>, I: Surfaces<N>, const N: usize>(
     if let (Some(ac), Some(ai)) = (ac, ai) {
         agree(&format!("{name} q̈"), &ac, &ai);
     }
+    agree(
+        &format!("{name} initial q"),
+        &c.initial_coordinates(),
+        &i.initial_coordinates(),
+    );
+    agree(
+        &format!("{name} initial v"),
+        &c.initial_velocities(),
+        &i.initial_velocities(),
+    );
     assert_eq!(c.walls().len(), i.walls().len());
     for (&wc, &wi) in c.walls().iter().zip(i.walls()) {
         let w = format!("{name} {}", c.wall_name(wc));

@@ -369,20 +369,23 @@ impl<const N: usize> Output<N> {
 }
 
 /// The model with `--set` applied and the starting state: the file's
-/// `[initial]` with `--set` applied, q on h(q) = 0, q̇ projected onto ker A.
+/// `[initial]` at the parameters in use (parameters are set first, so that
+/// an initial value such as `z = "r"` follows `--set r=1`), then the
+/// coordinates and velocities `--set` names; q on h(q) = 0, q̇ projected
+/// onto ker A.
 fn start<M: Surfaces<N>, const N: usize>(
     args: &SimulateArgs,
     mut model: M,
     derived: &[String],
 ) -> Result<(M, State<N>, Residual), String> {
-    let mut q = model.initial_coordinates();
-    let mut v = model.initial_velocities();
+    let is_state = |m: &M, name: &str| {
+        m.coordinate_names().contains(&name) || m.velocity_names().contains(&name)
+    };
     for (name, value) in &args.set {
-        if let Some(i) = model.coordinate_names().iter().position(|c| c == name) {
-            q[i] = *value;
-        } else if let Some(i) = model.velocity_names().iter().position(|c| c == name) {
-            v[i] = *value;
-        } else if derived.contains(name) {
+        if is_state(&model, name) {
+            continue;
+        }
+        if derived.contains(name) {
             return Err(format!(
                 "`{name}` is a derived parameter of {} (its value is computed from other parameters): set those instead",
                 model.name()
@@ -395,6 +398,15 @@ fn start<M: Surfaces<N>, const N: usize>(
                 model.velocity_names().join(", "),
                 model.name()
             ));
+        }
+    }
+    let mut q = model.initial_coordinates();
+    let mut v = model.initial_velocities();
+    for (name, value) in &args.set {
+        if let Some(i) = model.coordinate_names().iter().position(|c| c == name) {
+            q[i] = *value;
+        } else if let Some(i) = model.velocity_names().iter().position(|c| c == name) {
+            v[i] = *value;
         }
     }
     let start_residual = residual(&model, &q, &v);

@@ -111,6 +111,70 @@ fn parameters_and_initial_values_can_be_set() {
     );
 }
 
+/// `[initial]` values written with parameters follow `--set`: the §3.2.1
+/// ball starts on the floor (`z = "r"`) whatever its radius. With the
+/// file's value fixed it would start inside the floor of a larger ball.
+#[test]
+fn initial_values_follow_the_parameters_set() {
+    let dir = scratch("simulate-initial");
+    let out = dir.to_str().unwrap();
+    for r in ["1", "0.25"] {
+        let set = format!("r={r}");
+        let (ok, stdout, stderr) = dalembert(&[
+            "simulate",
+            "ball_bounce",
+            "--t-end",
+            "0.6",
+            "--set",
+            &set,
+            "--out",
+            out,
+        ]);
+        assert!(ok, "r = {r}: {stdout}\n{stderr}");
+        let text = std::fs::read_to_string(dir.join("ball_bounce.csv")).unwrap();
+        let first: Vec<f64> = text
+            .lines()
+            .nth(1)
+            .unwrap()
+            .split(',')
+            .take(4)
+            .map(|x| x.parse().unwrap())
+            .collect();
+        assert_eq!(
+            first[3],
+            r.parse::<f64>().unwrap(),
+            "z at the start, r = {r}"
+        );
+        // Back on the floor after 2·ż/g ≈ 0.41 s.
+        assert!(stdout.contains(" 1 collisions"), "r = {r}: {stdout}");
+    }
+    // A coordinate set by name still wins over the file's expression.
+    let (ok, stdout, stderr) = dalembert(&[
+        "simulate",
+        "ball_bounce",
+        "--t-end",
+        "0.1",
+        "--set",
+        "r=1",
+        "--set",
+        "z=2",
+        "--out",
+        out,
+    ]);
+    assert!(ok, "{stdout}\n{stderr}");
+    let text = std::fs::read_to_string(dir.join("ball_bounce.csv")).unwrap();
+    let z: f64 = text
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .nth(3)
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(z, 2.0);
+}
+
 #[test]
 fn refuses_clearly() {
     let (ok, _, stderr) = dalembert(&["simulate", "ball_wall"]);
@@ -158,6 +222,8 @@ name = "edge"
 surface = "1 + tan(alpha)*x - y"
 
 [initial]
+x = "-R/2"
+y = "-a/2"
 x_dot = "pi/4"
 y_dot = "-1/3"
 "#;
@@ -213,12 +279,15 @@ fn a_model_file_simulates_without_writing_rust() {
         }
     }
     assert!(rim > 0 && edge > 0, "rim {rim}, edge {edge}");
-    // The derived radius follows its parameter: with a = 3/2 the rim is at 3.
+    assert_eq!(rows[0].0[1..3], [-1.0, -0.5], "the start (-R/2, -a/2)");
+    // The derived radius follows its parameter: with a = 3/2 the rim is at
+    // 3, and the start, written with R and a, follows too.
     let (ok, stdout, stderr) = dalembert(&[
         "simulate", file, "--t-end", "20", "--set", "a=1.5", "--out", out,
     ]);
     assert!(ok, "{stdout}\n{stderr}");
     let rows = table_rows(&dir.join("table.csv"));
+    assert_eq!(rows[0].0[1..3], [-1.5, -0.75], "the start (-R/2, -a/2)");
     let rim: Vec<_> = rows.iter().filter(|(_, hit)| hit == "rim").collect();
     assert!(!rim.is_empty());
     for (r, _) in rim {

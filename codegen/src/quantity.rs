@@ -40,6 +40,20 @@ pub enum Quantity {
     Projector,
     /// A wall's (I − 2P)v, in closed form.
     Collide,
+    /// The starting state of the file's `[initial]`, at the parameters in
+    /// use.
+    InitialState,
+}
+
+/// What an emitted function takes besides the model's parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Inputs {
+    /// Nothing: a function of the parameters alone.
+    Parameters,
+    /// The coordinates q.
+    Coordinates,
+    /// The coordinates q and the velocities v.
+    Phase,
 }
 
 /// What an emitted function returns.
@@ -55,6 +69,8 @@ pub enum Shape {
     Rows,
     /// Up to N numbers, with how many are in use.
     Values,
+    /// A state: the coordinates, then the velocities.
+    State,
 }
 
 /// How the `Model` trait method returns the inherent function's value.
@@ -110,8 +126,8 @@ pub struct Spec {
     pub quantity: Quantity,
     /// The inherent function's name (for a wall, after `{wall}_`).
     pub name: &'static str,
-    /// Whether it takes the velocities as well as the coordinates.
-    pub velocities: bool,
+    /// What it takes besides the model's parameters.
+    pub inputs: Inputs,
     /// What it returns.
     pub shape: Shape,
     /// Its doc text; `{wall}` stands for the wall's name.
@@ -128,7 +144,7 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::MassMatrix,
         name: "mass_matrix",
-        velocities: false,
+        inputs: Inputs::Coordinates,
         shape: Shape::Matrix,
         doc: "The mass matrix G(q).",
         capability: Capability::Model,
@@ -137,7 +153,7 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::KineticEnergy,
         name: "kinetic_energy",
-        velocities: true,
+        inputs: Inputs::Phase,
         shape: Shape::Scalar,
         doc: "Kinetic energy T(q, v).",
         capability: Capability::Model,
@@ -146,7 +162,7 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::Potential,
         name: "potential",
-        velocities: false,
+        inputs: Inputs::Coordinates,
         shape: Shape::Scalar,
         doc: "Potential energy V(q).",
         capability: Capability::Dynamics,
@@ -155,7 +171,7 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::Constraints,
         name: "constraints",
-        velocities: false,
+        inputs: Inputs::Coordinates,
         shape: Shape::Rows,
         doc: "Rows of A(q).",
         capability: Capability::Model,
@@ -164,7 +180,7 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::Holonomic,
         name: "holonomic",
-        velocities: false,
+        inputs: Inputs::Coordinates,
         shape: Shape::Values,
         doc: "The holonomic constraints h(q) (zero on the constraint manifold); their differentials are the first rows of A.",
         capability: Capability::Dynamics,
@@ -173,7 +189,7 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::Forcing,
         name: "forcing",
-        velocities: true,
+        inputs: Inputs::Phase,
         shape: Shape::Vector,
         doc: "h(q, q̇): the equations of motion are G(q) q̈ + h(q, q̇) = A(q)ᵀλ.",
         capability: Capability::Dynamics,
@@ -182,7 +198,7 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::ConstraintDrift,
         name: "constraint_drift",
-        velocities: true,
+        inputs: Inputs::Phase,
         shape: Shape::Vector,
         doc: "Ȧq̇, one entry per row of A (the rest zero): A q̈ + Ȧq̇ = 0 along the motion.",
         capability: Capability::Dynamics,
@@ -191,16 +207,25 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::Accelerations,
         name: "accelerations",
-        velocities: true,
+        inputs: Inputs::Phase,
         shape: Shape::Vector,
         doc: "q̈ of the equations of motion G(q) q̈ + h(q, q̇) = A(q)ᵀλ, A(q) q̈ + Ȧq̇ = 0, in closed form (q̇ should satisfy A(q) q̇ = 0). Non-finite where G is singular.",
         capability: Capability::Dynamics,
         method: Some(("closed_form_accelerations", Forward::Some)),
     },
     Spec {
+        quantity: Quantity::InitialState,
+        name: "initial_state",
+        inputs: Inputs::Parameters,
+        shape: Shape::State,
+        doc: "The starting state of the model file's `[initial]` (zero where it is silent), at these parameters: (q, q̇).",
+        capability: Capability::Dynamics,
+        method: None,
+    },
+    Spec {
         quantity: Quantity::Surface,
         name: "surface",
-        velocities: false,
+        inputs: Inputs::Coordinates,
         shape: Shape::Scalar,
         doc: "Wall `{wall}`: the surface function f(q).",
         capability: Capability::Surfaces,
@@ -209,7 +234,7 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::Normal,
         name: "normal",
-        velocities: false,
+        inputs: Inputs::Coordinates,
         shape: Shape::Vector,
         doc: "Wall `{wall}`: its normal df(q), the first row of B.",
         capability: Capability::Walls,
@@ -218,7 +243,7 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::NormalVelocity,
         name: "normal_velocity",
-        velocities: true,
+        inputs: Inputs::Phase,
         shape: Shape::Scalar,
         doc: "Wall `{wall}`: the normal velocity df(q)·v, negative while approaching.",
         capability: Capability::Walls,
@@ -227,7 +252,7 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::SurfaceHessian,
         name: "surface_hessian",
-        velocities: true,
+        inputs: Inputs::Phase,
         shape: Shape::Scalar,
         doc: "Wall `{wall}`: vᵀ∇²f(q)v; along a motion f̈ = df(q)·q̈ + vᵀ∇²f(q)v.",
         capability: Capability::Surfaces,
@@ -236,7 +261,7 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::WallRows,
         name: "b_rows",
-        velocities: false,
+        inputs: Inputs::Coordinates,
         shape: Shape::Rows,
         doc: "Wall `{wall}`: the independent rows of B(q), the normal velocity first.",
         capability: Capability::Walls,
@@ -245,7 +270,7 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::Projector,
         name: "projector",
-        velocities: false,
+        inputs: Inputs::Coordinates,
         shape: Shape::Matrix,
         doc: "Wall `{wall}`: the projector P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B.",
         capability: Capability::Walls,
@@ -254,7 +279,7 @@ pub const TABLE: &[Spec] = &[
     Spec {
         quantity: Quantity::Collide,
         name: "collide",
-        velocities: true,
+        inputs: Inputs::Phase,
         shape: Shape::Vector,
         doc: "Wall `{wall}`: the collision map v⁺ = (I − 2P)v⁻.",
         capability: Capability::Walls,

@@ -99,6 +99,7 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
     if let Some(x) = &accelerations {
         functions.push(compile.applicable(cx, Quantity::Accelerations, x, 0, t_span)?);
     }
+    functions.push(initial_state(&sym, &compile, cx)?);
     let functions = functions.into_iter().flatten().collect();
     Ok(Derivation {
         model: model.clone(),
@@ -109,6 +110,29 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
         walls,
         functions,
     })
+}
+
+/// The `[initial]` state as a function of the parameters, so that it
+/// follows them (zero where the file is silent).
+fn initial_state(
+    sym: &symbols::Symbols,
+    compile: &Compiler,
+    cx: &mut Collector,
+) -> Result<Option<Function>, Reported> {
+    let exprs = &sym.model.initial_state;
+    let mut outputs = Vec::with_capacity(exprs.len());
+    for e in exprs {
+        outputs.push(match e {
+            Some(e) => sym.parse(e, cx)?,
+            None => Atom::num(0),
+        });
+    }
+    let span = exprs
+        .iter()
+        .flatten()
+        .next()
+        .map_or(&sym.model.kinetic_energy.span, |e| &e.span);
+    compile.applicable(cx, Quantity::InitialState, &outputs, 0, span)
 }
 
 /// Turns expressions into the emitted functions of one model.

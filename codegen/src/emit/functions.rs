@@ -10,7 +10,7 @@ use super::{Ctx, Scalar, doc_attr, ident};
 use crate::derive::{Function, WallDerivation};
 use crate::ir::camel;
 use crate::program::Program;
-use crate::quantity::Shape;
+use crate::quantity::{Inputs, Shape};
 
 /// `impl Model { consts, new, every function }`.
 pub(super) fn inherent_impl(d: &Ctx) -> TokenStream {
@@ -44,10 +44,12 @@ pub(super) fn inherent_impl(d: &Ctx) -> TokenStream {
             pub const Q: usize = #qn;
             /// Number of velocity components.
             pub const N: usize = #nn;
-            /// The model file's initial coordinates (`[initial]`, zero where silent).
+            /// The model file's initial coordinates (`[initial]`, zero where silent) at the
+            /// file's parameter values; `initial_state` follows the parameters in use.
             #[allow(clippy::approx_constant)]
             pub const INITIAL_COORDINATES: [#real; #qn] = [#(#init_q),*];
-            /// The model file's initial velocities (`[initial]`, zero where silent).
+            /// The model file's initial velocities (`[initial]`, zero where silent) at the
+            /// file's parameter values; `initial_state` follows the parameters in use.
             #[allow(clippy::approx_constant)]
             pub const INITIAL_VELOCITIES: [#real; #nn] = [#(#init_v),*];
             /// The model with the given parameters.
@@ -77,8 +79,8 @@ fn emit_function(d: &Ctx, f: &Function, wall: Option<&str>) -> TokenStream {
         Some(w) => (format!("{w}_{}", spec.name), spec.doc.replace("{wall}", w)),
         None => (spec.name.to_string(), spec.doc.to_string()),
     };
-    let (p, with_v) = (&f.program, spec.velocities);
-    let n = d.model.velocities.len();
+    let (p, inputs) = (&f.program, spec.inputs);
+    let (q, n) = dims(d);
     let nl = Literal::usize_unsuffixed(n);
     let real = real(d);
     let (ret, result) = match spec.shape {
@@ -111,8 +113,17 @@ fn emit_function(d: &Ctx, f: &Function, wall: Option<&str>) -> TokenStream {
             let array = quote! { [#(#outs),*] };
             counted(d, "Values", quote! { [f32; #nl] }, array, f.rows)
         }
+        Shape::State => {
+            let ql = Literal::usize_unsuffixed(q);
+            let q_outs = (0..q).map(|i| format_ident!("o{i}"));
+            let v_outs = (q..q + n).map(|i| format_ident!("o{i}"));
+            (
+                quote! { ([#real; #ql], [#real; #nl]) },
+                quote! { ([#(#q_outs),*], [#(#v_outs),*]) },
+            )
+        }
     };
-    function(d, &name, &doc, p, with_v, ret, result)
+    function(d, &name, &doc, p, inputs, ret, result)
 }
 
 /// P and the collision map of a wall evaluated at run time from the
@@ -156,16 +167,16 @@ pub(super) fn dims(d: &Ctx) -> (usize, usize) {
     (d.model.coordinates.len(), d.model.velocities.len())
 }
 
-/// `q: &[f64; Q]` and, when the function takes velocities, `v: &[f64; N]`.
-fn args(d: &Ctx, with_v: bool) -> TokenStream {
+/// Nothing, `q: &[f64; Q]`, or `q: &[f64; Q], v: &[f64; N]`.
+fn args(d: &Ctx, inputs: Inputs) -> TokenStream {
     let (q, n) = dims(d);
     let q = Literal::usize_unsuffixed(q);
     let n = Literal::usize_unsuffixed(n);
     let real = real(d);
-    if with_v {
-        quote! { q: &[#real; #q], v: &[#real; #n] }
-    } else {
-        quote! { q: &[#real; #q] }
+    match inputs {
+        Inputs::Parameters => quote! {},
+        Inputs::Coordinates => quote! { , q: &[#real; #q] },
+        Inputs::Phase => quote! { , q: &[#real; #q], v: &[#real; #n] },
     }
 }
 
@@ -176,19 +187,19 @@ fn function(
     name: &str,
     doc: &str,
     p: &Program,
-    with_v: bool,
+    inputs: Inputs,
     ret: TokenStream,
     result: TokenStream,
 ) -> TokenStream {
     let f = ident(name);
-    let args = args(d, with_v);
+    let args = args(d, inputs);
     let body = body(d, p);
     let doc = doc_attr(doc);
     quote! {
         #doc
         #[inline]
-        #[allow(unused_variables)]
-        pub fn #f(&self, #args) -> #ret { #body #result }
+        #[allow(unused_variables, clippy::approx_constant)]
+        pub fn #f(&self #args) -> #ret { #body #result }
     }
 }
 

@@ -9,7 +9,7 @@ use quote::{format_ident, quote};
 use super::functions::dims;
 use super::{Ctx, ident};
 use crate::ir::{Kind, camel};
-use crate::quantity::{Capability, Forward, Shape, Spec, TABLE};
+use crate::quantity::{Capability, Forward, Inputs, Shape, Spec, TABLE};
 
 pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
     let ty = format_ident!("{}", d.model.type_name());
@@ -67,8 +67,8 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
     quote! {
         #model_impl
         impl ::dalembert_runtime::Dynamics<#nl> for #ty {
-            fn initial_coordinates(&self) -> [f64; #ql] { Self::INITIAL_COORDINATES }
-            fn initial_velocities(&self) -> [f64; #nl] { Self::INITIAL_VELOCITIES }
+            fn initial_coordinates(&self) -> [f64; #ql] { self.initial_state().0 }
+            fn initial_velocities(&self) -> [f64; #nl] { self.initial_state().1 }
             #( #dynamics )*
         }
         impl ::dalembert_runtime::Surfaces<#nl> for #ty {
@@ -84,15 +84,10 @@ fn forward(d: &Ctx, spec: &Spec, variants: &[Ident]) -> Option<TokenStream> {
     let (q, n) = dims(d);
     let (ql, nl) = (Literal::usize_unsuffixed(q), Literal::usize_unsuffixed(n));
     let method = format_ident!("{method}");
-    let args = if spec.velocities {
-        quote! { q, v }
-    } else {
-        quote! { q }
-    };
-    let params = if spec.velocities {
-        quote! { q: &[f64; #ql], v: &[f64; #nl] }
-    } else {
-        quote! { q: &[f64; #ql] }
+    let (args, params) = match spec.inputs {
+        Inputs::Parameters => (quote! {}, quote! {}),
+        Inputs::Coordinates => (quote! { q }, quote! { q: &[f64; #ql] }),
+        Inputs::Phase => (quote! { q, v }, quote! { q: &[f64; #ql], v: &[f64; #nl] }),
     };
     let wrapped = |call: TokenStream| match wrap {
         Forward::Plain => call,
@@ -104,6 +99,7 @@ fn forward(d: &Ctx, spec: &Spec, variants: &[Ident]) -> Option<TokenStream> {
         Shape::Matrix => quote! { [[f64; #nl]; #nl] },
         Shape::Rows => quote! { ::dalembert_runtime::Rows<#nl> },
         Shape::Values => quote! { ::dalembert_runtime::Values<#nl> },
+        Shape::State => quote! { ([f64; #ql], [f64; #nl]) },
     };
     let ret = match wrap {
         Forward::Plain => ty,

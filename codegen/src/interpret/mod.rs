@@ -96,7 +96,7 @@ pub struct Interpreted<const N: usize> {
     velocities: &'static [&'static str],
     parameters: &'static [&'static str],
     values: Vec<f64>,
-    initial: ([f64; N], [f64; N]),
+    initial_state: Compiled,
     mass_matrix: Compiled,
     kinetic_energy: Compiled,
     potential: Compiled,
@@ -192,15 +192,12 @@ impl<const N: usize> Interpreted<N> {
                 closed_form,
             });
         }
-        let mut initial = ([0.0; N], [0.0; N]);
-        initial.0.copy_from_slice(&m.initial[..N]);
-        initial.1.copy_from_slice(&m.initial[N..2 * N]);
         Ok(Self {
             name: leak_names(std::iter::once(m.name.clone()))[0],
             coordinates: leak_names(m.coordinates.iter().cloned()),
             velocities: leak_names(m.velocities.iter().cloned()),
             parameters: leak_names(m.params.iter().map(|p| p.name.clone())),
-            initial,
+            initial_state: model_fn(Quantity::InitialState)?,
             mass_matrix: model_fn(Quantity::MassMatrix)?,
             kinetic_energy: model_fn(Quantity::KineticEnergy)?,
             potential: model_fn(Quantity::Potential)?,
@@ -215,15 +212,9 @@ impl<const N: usize> Interpreted<N> {
         })
     }
 
-    /// Sets the starting state the simulator's callers take from
-    /// [`Dynamics::initial_coordinates`] and
-    /// [`Dynamics::initial_velocities`].
-    pub fn set_initial(&mut self, q: [f64; N], v: [f64; N]) {
-        self.initial = (q, v);
-    }
-
     fn programs_mut(&mut self) -> impl Iterator<Item = &mut Compiled> {
         let model = [
+            &mut self.initial_state,
             &mut self.mass_matrix,
             &mut self.kinetic_energy,
             &mut self.potential,
@@ -276,6 +267,18 @@ impl<const N: usize> Interpreted<N> {
 
     fn rows(&self, c: &Compiled, q: &[f64; N]) -> Rows<N> {
         Rows::new(self.matrix(c, q), c.rows)
+    }
+
+    /// The `[initial]` state at the parameters in use.
+    fn initial_state(&self) -> ([f64; N], [f64; N]) {
+        self.initial_state
+            .eval(self.np(), &[0.0; N], &[0.0; N], |o| {
+                let at = |i: usize| o.get(i).copied().unwrap_or(0.0);
+                (
+                    core::array::from_fn(at),
+                    core::array::from_fn(|i| at(N + i)),
+                )
+            })
     }
 
     fn wall(&self, wall: WallIndex) -> &WallPrograms {
@@ -365,10 +368,10 @@ impl<const N: usize> Walls<N, N> for Interpreted<N> {
 
 impl<const N: usize> Dynamics<N> for Interpreted<N> {
     fn initial_coordinates(&self) -> [f64; N] {
-        self.initial.0
+        self.initial_state().0
     }
     fn initial_velocities(&self) -> [f64; N] {
-        self.initial.1
+        self.initial_state().1
     }
     fn potential(&self, q: &[f64; N]) -> f64 {
         self.scalar(&self.potential, q, &[])

@@ -228,6 +228,9 @@ pub struct Model {
     /// The initial state for simulations: one value per coordinate, then
     /// one per velocity (zero where the file's `[initial]` is silent).
     pub initial: Vec<f64>,
+    /// The same state as expressions of the parameters, slot by slot
+    /// (`None`: zero), so that it follows parameters set later.
+    pub initial_state: Vec<Option<Expr>>,
     /// The model file's text.
     pub source: String,
     /// The model file.

@@ -91,7 +91,7 @@ impl Validator<'_> {
             );
         }
         let state_len = coordinates.len() + velocities.len();
-        let initial =
+        let (initial, initial_state) =
             self.initial_values(&params, &derived_names, &definitions, initial, state_len);
         Some(Model {
             name,
@@ -109,6 +109,7 @@ impl Validator<'_> {
             walls,
             projector,
             initial,
+            initial_state,
             source: self.text.to_string(),
             file: path.to_path_buf(),
         })
@@ -497,8 +498,8 @@ impl Validator<'_> {
         out
     }
 
-    /// The initial values at the file's parameter values; names other than
-    /// parameters are reported.
+    /// The initial values at the file's parameter values, and the
+    /// expressions slot by slot; names other than parameters are reported.
     fn initial_values(
         &mut self,
         params: &[Param],
@@ -506,7 +507,7 @@ impl Validator<'_> {
         definitions: &[(String, Expr)],
         initial: Vec<(usize, String, Expr)>,
         n: usize,
-    ) -> Vec<f64> {
+    ) -> (Vec<f64>, Vec<Option<Expr>>) {
         let mut env: HashMap<String, f64> =
             params.iter().map(|p| (p.name.clone(), p.value)).collect();
         for (name, e) in definitions.iter().filter(|(d, _)| derived.contains(d)) {
@@ -515,6 +516,7 @@ impl Validator<'_> {
             }
         }
         let mut out = vec![0.0; n];
+        let mut exprs = vec![None; n];
         for (slot, name, e) in initial {
             let mut foreign = None;
             e.node.visit_names(&mut |k, r| {
@@ -535,7 +537,10 @@ impl Validator<'_> {
                 continue;
             }
             match e.node.value(&|k| env.get(k).copied()) {
-                Some(v) if v.is_finite() && slot < n => out[slot] = v,
+                Some(v) if v.is_finite() && slot < n => {
+                    out[slot] = v;
+                    exprs[slot] = Some(e);
+                }
                 _ => {
                     self.cx.error(
                         ErrorKind::Structure(format!(
@@ -547,7 +552,7 @@ impl Validator<'_> {
                 }
             }
         }
-        out
+        (out, exprs)
     }
 
     /// A derived parameter may use only parameters (and other derived

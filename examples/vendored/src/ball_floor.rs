@@ -74,10 +74,12 @@ impl BallFloor {
     pub const Q: usize = 0;
     /// Number of velocity components.
     pub const N: usize = 6;
-    /// The model file's initial coordinates (`[initial]`, zero where silent).
+    /// The model file's initial coordinates (`[initial]`, zero where silent) at the
+    /// file's parameter values; `initial_state` follows the parameters in use.
     #[allow(clippy::approx_constant)]
     pub const INITIAL_COORDINATES: [f64; 0] = [];
-    /// The model file's initial velocities (`[initial]`, zero where silent).
+    /// The model file's initial velocities (`[initial]`, zero where silent) at the
+    /// file's parameter values; `initial_state` follows the parameters in use.
     #[allow(clippy::approx_constant)]
     pub const INITIAL_VELOCITIES: [f64; 6] = [0f64, 0f64, 0f64, 0f64, 0f64, 0f64];
     /// The model with the given parameters.
@@ -86,7 +88,7 @@ impl BallFloor {
     }
     /// The mass matrix G(q).
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn mass_matrix(&self, q: &[f64; 0]) -> [[f64; 6]; 6] {
         let i0: f64 = self.params.m;
         let i2: f64 = self.params.J;
@@ -137,7 +139,7 @@ impl BallFloor {
     }
     /// Kinetic energy T(q, v).
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn kinetic_energy(&self, q: &[f64; 0], v: &[f64; 6]) -> f64 {
         let i0: f64 = self.params.m;
         let i2: f64 = self.params.J;
@@ -163,7 +165,7 @@ impl BallFloor {
     }
     /// Rows of A(q).
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn constraints(&self, q: &[f64; 0]) -> ::dalembert_runtime::Rows<6> {
         ::dalembert_runtime::Rows::new(
             [
@@ -179,7 +181,7 @@ impl BallFloor {
     }
     /// Wall `floor`: its normal df(q), the first row of B.
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn floor_normal(&self, q: &[f64; 0]) -> [f64; 6] {
         let o0: f64 = 0f64;
         let o1: f64 = 0f64;
@@ -191,7 +193,7 @@ impl BallFloor {
     }
     /// Wall `floor`: the normal velocity df(q)·v, negative while approaching.
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn floor_normal_velocity(&self, q: &[f64; 0], v: &[f64; 6]) -> f64 {
         let i5: f64 = v[2];
         let o0: f64 = i5;
@@ -199,7 +201,7 @@ impl BallFloor {
     }
     /// Wall `floor`: the independent rows of B(q), the normal velocity first.
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn floor_b_rows(&self, q: &[f64; 0]) -> ::dalembert_runtime::Rows<6> {
         let i1: f64 = self.params.r;
         let o10: f64 = -(i1);
@@ -234,7 +236,7 @@ impl BallFloor {
     }
     /// Wall `floor`: the projector P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B.
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn floor_projector(&self, q: &[f64; 0]) -> [[f64; 6]; 6] {
         let i0: f64 = self.params.m;
         let i1: f64 = self.params.r;
@@ -292,7 +294,7 @@ impl BallFloor {
     }
     /// Wall `floor`: the collision map v⁺ = (I − 2P)v⁻.
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn floor_collide(&self, q: &[f64; 0], v: &[f64; 6]) -> [f64; 6] {
         let i0: f64 = self.params.m;
         let i1: f64 = self.params.r;

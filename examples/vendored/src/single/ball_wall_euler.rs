@@ -22,6 +22,7 @@
 //   forcing                      17 add, 42 mul, 0 div, 4 fn (63 in all)
 //   constraint_drift             4 add, 15 mul, 0 div, 4 fn (23 in all)
 //   accelerations                10 add, 30 mul, 2 div, 4 fn (46 in all)
+//   initial_state                0 add, 1 mul, 0 div, 0 fn (1 in all)
 //   wall_surface                 1 add, 1 mul, 0 div, 0 fn (2 in all)
 //   wall_normal                  0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   wall_normal_velocity         0 add, 0 mul, 0 div, 0 fn (0 in all)
@@ -100,10 +101,12 @@ impl BallWallEuler {
     pub const Q: usize = 5;
     /// Number of velocity components.
     pub const N: usize = 5;
-    /// The model file's initial coordinates (`[initial]`, zero where silent).
+    /// The model file's initial coordinates (`[initial]`, zero where silent) at the
+    /// file's parameter values; `initial_state` follows the parameters in use.
     #[allow(clippy::approx_constant)]
     pub const INITIAL_COORDINATES: [f32; 5] = [1.5f32, 0f32, 0f32, 1.5707964f32, 0f32];
-    /// The model file's initial velocities (`[initial]`, zero where silent).
+    /// The model file's initial velocities (`[initial]`, zero where silent) at the
+    /// file's parameter values; `initial_state` follows the parameters in use.
     #[allow(clippy::approx_constant)]
     pub const INITIAL_VELOCITIES: [f32; 5] = [-0.5f32, 0f32, 2f32, 0f32, 1f32];
     /// The model with the given parameters.
@@ -112,7 +115,7 @@ impl BallWallEuler {
     }
     /// The mass matrix G(q).
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn mass_matrix(&self, q: &[f32; 5]) -> [[f32; 5]; 5] {
         let i0: f32 = self.params.m;
         let i2: f32 = self.params.J;
@@ -153,7 +156,7 @@ impl BallWallEuler {
     }
     /// Kinetic energy T(q, v).
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn kinetic_energy(&self, q: &[f32; 5], v: &[f32; 5]) -> f32 {
         let i0: f32 = self.params.m;
         let i2: f32 = self.params.J;
@@ -181,7 +184,7 @@ impl BallWallEuler {
     }
     /// Potential energy V(q).
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn potential(&self, q: &[f32; 5]) -> f32 {
         let i0: f32 = self.params.m;
         let i1: f32 = self.params.r;
@@ -196,7 +199,7 @@ impl BallWallEuler {
     }
     /// Rows of A(q).
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn constraints(&self, q: &[f32; 5]) -> ([[f32; 5]; 5], usize) {
         let i1: f32 = self.params.r;
         let i7: f32 = q[2];
@@ -229,13 +232,13 @@ impl BallWallEuler {
     }
     /// The holonomic constraints h(q) (zero on the constraint manifold); their differentials are the first rows of A.
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn holonomic(&self, q: &[f32; 5]) -> ([f32; 5], usize) {
         ([0.0, 0.0, 0.0, 0.0, 0.0], 0)
     }
     /// h(q, q̇): the equations of motion are G(q) q̈ + h(q, q̇) = A(q)ᵀλ.
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn forcing(&self, q: &[f32; 5], v: &[f32; 5]) -> [f32; 5] {
         let i0: f32 = self.params.m;
         let i2: f32 = self.params.J;
@@ -310,7 +313,7 @@ impl BallWallEuler {
     }
     /// Ȧq̇, one entry per row of A (the rest zero): A q̈ + Ȧq̇ = 0 along the motion.
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn constraint_drift(&self, q: &[f32; 5], v: &[f32; 5]) -> [f32; 5] {
         let i1: f32 = self.params.r;
         let i7: f32 = q[2];
@@ -345,7 +348,7 @@ impl BallWallEuler {
     }
     /// q̈ of the equations of motion G(q) q̈ + h(q, q̇) = A(q)ᵀλ, A(q) q̈ + Ȧq̇ = 0, in closed form (q̇ should satisfy A(q) q̇ = 0). Non-finite where G is singular.
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn accelerations(&self, q: &[f32; 5], v: &[f32; 5]) -> [f32; 5] {
         let i0: f32 = self.params.m;
         let i1: f32 = self.params.r;
@@ -405,9 +408,25 @@ impl BallWallEuler {
         let o1: f32 = 0f32;
         [o0, o1, o2, o3, o4]
     }
+    /// The starting state of the model file's `[initial]` (zero where it is silent), at these parameters: (q, q̇).
+    #[inline]
+    #[allow(unused_variables, clippy::approx_constant)]
+    pub fn initial_state(&self) -> ([f32; 5], [f32; 5]) {
+        let o3: f32 = 3.1415927f32 * 0.5f32;
+        let o0: f32 = 1.5f32;
+        let o1: f32 = 0f32;
+        let o2: f32 = 0f32;
+        let o4: f32 = 0f32;
+        let o5: f32 = -0.5f32;
+        let o6: f32 = 0f32;
+        let o7: f32 = 2f32;
+        let o8: f32 = 0f32;
+        let o9: f32 = 1f32;
+        ([o0, o1, o2, o3, o4], [o5, o6, o7, o8, o9])
+    }
     /// Wall `wall`: the surface function f(q).
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn wall_surface(&self, q: &[f32; 5]) -> f32 {
         let i1: f32 = self.params.r;
         let i5: f32 = q[0];
@@ -417,7 +436,7 @@ impl BallWallEuler {
     }
     /// Wall `wall`: its normal df(q), the first row of B.
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn wall_normal(&self, q: &[f32; 5]) -> [f32; 5] {
         let o0: f32 = 1f32;
         let o1: f32 = 0f32;
@@ -428,7 +447,7 @@ impl BallWallEuler {
     }
     /// Wall `wall`: the normal velocity df(q)·v, negative while approaching.
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn wall_normal_velocity(&self, q: &[f32; 5], v: &[f32; 5]) -> f32 {
         let i10: f32 = v[0];
         let o0: f32 = i10;
@@ -436,14 +455,14 @@ impl BallWallEuler {
     }
     /// Wall `wall`: vᵀ∇²f(q)v; along a motion f̈ = df(q)·q̈ + vᵀ∇²f(q)v.
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn wall_surface_hessian(&self, q: &[f32; 5], v: &[f32; 5]) -> f32 {
         let o0: f32 = 0f32;
         o0
     }
     /// Wall `wall`: the independent rows of B(q), the normal velocity first.
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn wall_b_rows(&self, q: &[f32; 5]) -> ([[f32; 5]; 5], usize) {
         let i1: f32 = self.params.r;
         let i7: f32 = q[2];
@@ -487,7 +506,7 @@ impl BallWallEuler {
     }
     /// Wall `wall`: the projector P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B.
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn wall_projector(&self, q: &[f32; 5]) -> [[f32; 5]; 5] {
         let i0: f32 = self.params.m;
         let i1: f32 = self.params.r;
@@ -580,7 +599,7 @@ impl BallWallEuler {
     }
     /// Wall `wall`: the collision map v⁺ = (I − 2P)v⁻.
     #[inline]
-    #[allow(unused_variables)]
+    #[allow(unused_variables, clippy::approx_constant)]
     pub fn wall_collide(&self, q: &[f32; 5], v: &[f32; 5]) -> [f32; 5] {
         let i0: f32 = self.params.m;
         let i1: f32 = self.params.r;
