@@ -68,7 +68,7 @@ fn step<M: Surfaces<N> + Default, const N: usize>(c: &mut Criterion) {
 fn simulate(c: &mut Criterion) {
     let ball = BallBounce::default();
     // §3.2.1 with the file's u = 2: a flight lasts 2u/g.
-    let flight = 2.0 * 2.0 / ball.params.g;
+    let flight = 2.0 * 2.0 / ball.params().g;
     let mut group = c.benchmark_group("simulate");
     for bounces in [100, 1000] {
         group.throughput(Throughput::Elements(bounces));

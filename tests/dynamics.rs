@@ -72,7 +72,7 @@ fn chaplygin_sleigh_moves_as_known() {
         assert!(phidd.abs() < 1e-12);
         assert!((xdd * phi.cos() + ydd * phi.sin()).abs() < 1e-12);
         // The blade's reaction holds the puck on its circle: m u φ̇ = |λ|.
-        assert!((acc.lambda[0].abs() - puck.params.m * (u * w).abs()).abs() < 1e-9);
+        assert!((acc.lambda[0].abs() - puck.params().m * (u * w).abs()).abs() < 1e-9);
     }
 }
 

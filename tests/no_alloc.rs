@@ -115,7 +115,7 @@ for_each_model!(no_alloc_test);
 fn simulator_does_not_allocate() {
     use dalembert::runtime::simulate::{Integrator, Rk4, Settings, Simulator, State};
     let ball = BallBounce::default();
-    let r = ball.params.r;
+    let r = ball.params().r;
     let q = [0.0, 0.0, r + 1.0, 0.0, std::f64::consts::FRAC_PI_2, 0.0];
     let v = [1.0, 0.0, 0.0, 0.0, 0.0, -5.0];
     let rk4 = Settings {

@@ -65,7 +65,7 @@ fn initial<M: Dynamics<N> + Default, const N: usize>() -> State<N> {
 
 /// The bob of `PendulumWall` at rest at angle θ₀ on the left.
 fn bob_at_rest(p: &PendulumWall, theta0: f64) -> State<2> {
-    let l = p.params.l;
+    let l = p.params().l;
     State {
         t: 0.0,
         q: [-l * theta0.sin(), -l * theta0.cos()],
@@ -81,8 +81,8 @@ fn bob_at_rest(p: &PendulumWall, theta0: f64) -> State<2> {
 #[test]
 fn free_pendulum_has_the_elliptic_period() {
     let mut p = PendulumWall::default();
-    p.params.d = 2.0;
-    let (l, g) = (p.params.l, p.params.g);
+    assert!(p.set_parameter_named("d", 2.0));
+    let (l, g) = (p.params().l, p.params().g);
     let theta0 = 1.2;
     // After one period, 4√(l/g) K(sin(θ₀/2)), the bob is back at rest at
     // its start.
@@ -123,7 +123,7 @@ fn free_pendulum_has_the_elliptic_period() {
 #[test]
 fn pendulum_bounces_off_the_wall_as_the_textbook_says() {
     let p = PendulumWall::default();
-    let (l, g, d) = (p.params.l, p.params.g, p.params.d);
+    let (l, g, d) = (p.params().l, p.params().g, p.params().d);
     let theta0 = 1.0;
     let theta_w = (d / l).asin();
     let t_hit = pendulum_time(l, g, theta0, theta_w);
@@ -174,7 +174,12 @@ fn pendulum_bounces_off_the_wall_as_the_textbook_says() {
 #[test]
 fn nonholonomic_pendulum_is_periodic_over_ten_thousand_bounces() {
     let ball = BallBounce::default();
-    let (m, r, j, g) = (ball.params.m, ball.params.r, ball.params.J, ball.params.g);
+    let (m, r, j, g) = (
+        ball.params().m,
+        ball.params().r,
+        ball.params().J,
+        ball.params().g,
+    );
     let (u, v) = (2.0, 1.0);
     // At φ = ψ = 0, θ = π/2: ω = (θ', −ψ', φ').
     let q = [0.0, 0.0, r, 0.0, std::f64::consts::FRAC_PI_2, 0.0];
@@ -228,7 +233,7 @@ fn nonholonomic_pendulum_is_periodic_over_ten_thousand_bounces() {
 fn parabolic_flights_end_on_the_floor_in_one_step() {
     let ball = BallBounce::default();
     let start = initial::<BallBounce, 6>();
-    let flight = 2.0 * 2.0 / ball.params.g;
+    let flight = 2.0 * 2.0 / ball.params().g;
     let mut sim = Simulator::new(&ball, start, Settings::default()).unwrap();
     let mut n = 0u64;
     let stats = sim
@@ -309,7 +314,7 @@ fn omega(q: &[f64; 5], v: &[f64; 5]) -> [f64; 3] {
 #[test]
 fn rolling_ball_meets_the_wall_as_theorem_3_1_says() {
     let ball = BallWallEuler::default();
-    let p = ball.params;
+    let p = *ball.params();
     let (m, r, j, a) = (p.m, p.r, p.J, p.a);
     let jp = j + r * r * m;
     let jt = j + r * r * m / 2.0;
@@ -378,7 +383,7 @@ fn rolling_ball_meets_the_wall_as_theorem_3_1_says() {
 fn two_masses_in_a_box_follow_the_textbook_event_by_event() {
     use dalembert::models::masses_on_line::Wall;
     let sys = MassesOnLine::default();
-    let (m1, m2, len) = (sys.params.m1, sys.params.m2, sys.params.L);
+    let (m1, m2, len) = (sys.params().m1, sys.params().m2, sys.params().L);
     let start = State {
         t: 0.0,
         q: [0.2, 0.6],
@@ -539,7 +544,7 @@ fn simultaneous_contacts_are_reported() {
 #[test]
 fn grazing_contacts_are_reported() {
     let ball = BallBounce::default();
-    let r = ball.params.r;
+    let r = ball.params().r;
     // 1e-15 above the floor, fast along it: the floor is met at a normal
     // speed √(2g·1e-15) ≈ 1.4e-7, about 1e-9 of the speed.
     let q = [0.0, 0.0, r + 1e-15, 0.0, std::f64::consts::FRAC_PI_2, 0.0];
@@ -562,7 +567,7 @@ fn grazing_contacts_are_reported() {
 #[test]
 fn bad_states_are_typed_errors() {
     let ball = BallBounce::default();
-    let r = ball.params.r;
+    let r = ball.params().r;
     let fly = |q: [f64; 6], v: [f64; 6]| {
         Simulator::new(&ball, State { t: 0.0, q, v }, Settings::default())
             .and_then(|mut s| s.run(2.0, |_| true))

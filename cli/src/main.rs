@@ -165,10 +165,7 @@ fn section_3_2_1_simulated() -> Result<bool, String> {
     println!(
         "==================== §3.2.1 simulated: 20 bounces of ball_bounce ===================="
     );
-    let flight = 2.0 * 2.0
-        / <dalembert::models::BallBounce as Default>::default()
-            .params
-            .g;
+    let flight = 2.0 * 2.0 / dalembert::models::BallBounce::default().params().g;
     let t_end = format!("{}", 20.5 * flight);
     let cli = Cli::try_parse_from([
         "dalembert",
@@ -190,7 +187,7 @@ fn section_3_2_1_simulated() -> Result<bool, String> {
 /// come back reversed.
 fn section_3_2_1_collision_map() {
     let ball = BallFloor::default();
-    let p = ball.params;
+    let p = *ball.params();
     let (v, u) = (1.5, 2.0);
     let v_minus = [-v, 0.0, -u, 0.0, p.r * p.m * v / p.J, 0.0];
     let v_plus = ball.collide(BallFloor::WALLS[0], &[], &v_minus);

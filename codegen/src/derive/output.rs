@@ -104,21 +104,27 @@ impl Derivation {
         self.functions.iter().find(|f| f.quantity == q)
     }
 
-    /// Operation counts of every emitted function, by its name in the
-    /// generated code.
-    pub fn op_counts(&self) -> Vec<(String, OpCount)> {
+    /// Every emitted function with its name in the generated code (a wall's
+    /// is `{wall}_{name}`), the model's first, in file order.
+    pub fn named_functions(&self) -> Vec<(String, &Function)> {
         let model = self
             .functions
             .iter()
-            .map(|f| (f.quantity.spec().name.to_string(), f.program.op_count()));
+            .map(|f| (f.quantity.spec().name.to_string(), f));
         let walls = self.walls.iter().flat_map(|w| {
-            w.functions.iter().map(move |f| {
-                (
-                    format!("{}_{}", w.name, f.quantity.spec().name),
-                    f.program.op_count(),
-                )
-            })
+            w.functions
+                .iter()
+                .map(move |f| (format!("{}_{}", w.name, f.quantity.spec().name), f))
         });
         model.chain(walls).collect()
+    }
+
+    /// Operation counts of every emitted function, by its name in the
+    /// generated code.
+    pub fn op_counts(&self) -> Vec<(String, OpCount)> {
+        self.named_functions()
+            .into_iter()
+            .map(|(name, f)| (name, f.program.op_count()))
+            .collect()
     }
 }

@@ -8,11 +8,12 @@ use symbolica::prelude::*;
 use super::checks::{self, WallRows};
 use super::lower::Lowering;
 use super::mechanics::{Exact, Raw, RawWall};
-use super::output::{Geometry, Projection, WallDerivation};
+use super::output::{Function, Geometry, Projection, WallDerivation};
 use super::symbols::Symbols;
-use super::{Field, Rat, rows_matrix, strings};
+use super::{Field, Rat, is_zero, rows_matrix, strings};
 use crate::diag::{Collector, ErrorKind, Reported};
 use crate::ir::{Kind, Wall};
+use crate::program::Entry;
 use crate::quantity::Quantity;
 
 /// What every wall shares: the model's symbols, lowering, exact G and A,
@@ -94,10 +95,13 @@ fn wall(
                 c.compile
                     .applicable(cx, Quantity::Projector, &flat, 0, &w.span)?,
             );
-            functions.extend(
-                c.compile
+            let linear = linear_collision(c, cx, p, &w.span)?;
+            functions.extend(match linear {
+                Some(f) => Some(f),
+                None => c
+                    .compile
                     .applicable(cx, Quantity::Collide, collide, 0, &w.span)?,
-            );
+            });
             Projection::ClosedForm {
                 projector: strings(p),
                 collision: collide
@@ -218,6 +222,54 @@ fn closed_form(
         })
         .collect();
     Some((p_atoms, collide))
+}
+
+/// The collision map as v⁺ = M v with M = I − 2P, where P does not depend
+/// on the coordinates: M's entries are then parameter-only work, done once,
+/// and a call is one multiplication per entry that is not 0 or ±1. `None`
+/// where P depends on q (there (I − 2P)v as an expression of q and v is
+/// cheaper than M's n² entries).
+fn linear_collision(
+    c: &Context,
+    cx: &mut Collector,
+    p: &[Vec<Atom>],
+    span: &std::ops::Range<usize>,
+) -> Result<Option<Function>, Reported> {
+    let sym = c.sym;
+    let varies = |e: &Atom| sym.coords.iter().any(|q| !is_zero(&e.derivative(*q)));
+    if p.iter().flatten().any(varies) {
+        return Ok(None);
+    }
+    let n = sym.vels.len();
+    let mut entries = Vec::with_capacity(n * n);
+    let mut general = Vec::new();
+    for (i, row) in p.iter().enumerate() {
+        for (j, pij) in row.iter().enumerate() {
+            let delta = Atom::num(i64::from(i == j));
+            let m = delta - Atom::num(2) * pij.clone();
+            entries.push(if is_zero(&m) {
+                Entry::Zero
+            } else if is_zero(&(m.clone() - Atom::num(1))) {
+                Entry::One
+            } else if is_zero(&(m.clone() + Atom::num(1))) {
+                Entry::MinusOne
+            } else {
+                general.push(m);
+                Entry::General
+            });
+        }
+    }
+    let Some(f) = c
+        .compile
+        .applicable(cx, Quantity::Collide, &general, 0, span)?
+    else {
+        return Ok(None);
+    };
+    let velocities = sym.params.len() + sym.coords.len();
+    Ok(Some(Function {
+        program: f.program.times_vector(&entries, n, velocities),
+        ..f
+    }))
 }
 
 /// P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B.

@@ -1,12 +1,15 @@
 //! A straight-line program as Rust statements: inputs bound to `i{k}`,
 //! temporaries `t{k}`, outputs `o{k}`; sin and cos of one value computed by
-//! one `sincos` call.
+//! one `sincos` call; parameter-only values stored once (`pre[k]`) and read
+//! per call (`self.pre[k]`).
+
+use std::collections::HashMap;
 
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
 use super::{Ctx, Scalar, ident};
-use crate::program::{Func, Instr, Program, Slot};
+use crate::program::{Emit, Func, Instr, Program, Slot};
 
 /// `f64` or `f32`.
 pub(super) fn real(d: &Ctx) -> TokenStream {
@@ -33,32 +36,111 @@ pub(super) fn libm_fn(d: &Ctx, name: &str) -> TokenStream {
     quote! { ::dalembert_runtime::libm::#f }
 }
 
-/// Statements computing `o0, o1, …` from the program.
-pub(super) fn body(d: &Ctx, p: &Program) -> TokenStream {
+/// Where statements go: the per-call function, or the block run once per
+/// parameter set.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum Place {
+    Call,
+    Once,
+}
+
+/// Statements computing `o0, o1, …` from the program, each instruction as
+/// `plan` says for `place`: computed, stored as `pre[k]`, read from
+/// `self.pre[k]`, split at its leading operands, or left out.
+pub(super) fn statements(d: &Ctx, p: &Program, plan: &[Emit], place: Place) -> TokenStream {
+    // The operands each instruction reads here.
+    let reads = |i: usize| -> &[Slot] {
+        let s = p.instrs[i].sources();
+        match (plan[i], place) {
+            (Emit::Compute | Emit::Store(_), _) => s,
+            (Emit::Leading(_, n), Place::Once) => &s[..n],
+            (Emit::Leading(_, n), Place::Call) => &s[n..],
+            (Emit::Skip | Emit::Load(_), _) => &[],
+        }
+    };
     let mut used = vec![false; p.inputs];
-    for ins in &p.instrs {
-        for s in sources(ins) {
-            if let Slot::Input(i) = s {
-                used[i] = true;
+    for i in 0..p.instrs.len() {
+        for s in reads(i) {
+            if let Slot::Input(k) = s {
+                used[*k] = true;
             }
         }
     }
+    let real = real(d);
+    let params = match place {
+        Place::Call => quote! { self.params },
+        Place::Once => quote! { params },
+    };
     let inputs = used.iter().enumerate().filter(|(_, u)| **u).map(|(i, _)| {
         let name = format_ident!("i{i}");
-        let value = input_value(d, i);
-        let real = real(d);
+        let value = input_value(d, i, &params);
         quote! { let #name: #real = #value; }
     });
+    // sin and cos of a value share one sincos where both are computed here.
+    let computed = |i: usize| matches!(plan[i], Emit::Compute | Emit::Store(_));
     let pairs = p.sincos_pairs();
+    let mut halves: HashMap<usize, usize> = HashMap::new();
+    for (i, pair) in pairs.iter().enumerate() {
+        if let Some((k, _)) = pair.filter(|_| computed(i)) {
+            *halves.entry(k).or_default() += 1;
+        }
+    }
     let stmts = p
         .instrs
         .iter()
         .zip(&pairs)
-        .map(|(ins, pair)| match (ins, pair) {
-            (Instr::Fun(dst, f, src), Some(pair)) => sincos(d, p, *dst, *f, *src, *pair),
-            _ => instr(d, p, ins),
+        .enumerate()
+        .map(|(i, (ins, pair))| {
+            let computation = || match (ins, pair) {
+                (Instr::Fun(dst, f, src), Some(pair)) if halves.get(&pair.0) == Some(&2) => {
+                    sincos(d, p, *dst, *f, *src, *pair)
+                }
+                _ => instr(d, p, ins),
+            };
+            let dst = slot(d, p, ins.dst());
+            match (plan[i], place) {
+                (Emit::Skip, _) => TokenStream::new(),
+                (Emit::Compute, _) => computation(),
+                (Emit::Store(k), _) => {
+                    let (computation, k) = (computation(), Literal::usize_unsuffixed(k));
+                    quote! { #computation pre[#k] = #dst; }
+                }
+                (Emit::Load(k), _) => {
+                    let k = Literal::usize_unsuffixed(k);
+                    quote! { let #dst: #real = self.pre[#k]; }
+                }
+                (Emit::Leading(k, n), Place::Once) => {
+                    let k = Literal::usize_unsuffixed(k);
+                    let value = operation(d, p, ins, None, &ins.sources()[..n]);
+                    quote! { pre[#k] = #value; }
+                }
+                (Emit::Leading(k, n), Place::Call) => {
+                    let k = Literal::usize_unsuffixed(k);
+                    let stored = quote! { self.pre[#k] };
+                    let value = operation(d, p, ins, Some(stored), &ins.sources()[n..]);
+                    quote! { let #dst: #real = #value; }
+                }
+            }
         });
     quote! { #(#inputs)* #(#stmts)* }
+}
+
+/// The sum or product `ins` computes, over `first` (a value already
+/// computed, standing for leading operands) and then `operands`.
+fn operation(
+    d: &Ctx,
+    p: &Program,
+    ins: &Instr,
+    first: Option<TokenStream>,
+    operands: &[Slot],
+) -> TokenStream {
+    match ins {
+        Instr::Add(..) => {
+            let rest = operands.iter().map(|&x| slot(d, p, x));
+            join(first.into_iter().chain(rest), quote! { + })
+        }
+        _ => product(d, p, first, operands),
+    }
 }
 
 /// One half of a sin/cos pair: the first computes both into `sc{k}_sin`
@@ -83,23 +165,14 @@ fn sincos(
     quote! { #both let #dst: #real = #mine; }
 }
 
-fn sources(ins: &Instr) -> Vec<Slot> {
-    match ins {
-        Instr::Add(_, s) | Instr::Mul(_, s) => s.clone(),
-        Instr::Pow(_, s, _) | Instr::Powf(_, s, _) | Instr::Fun(_, _, s) | Instr::Assign(_, s) => {
-            vec![*s]
-        }
-    }
-}
-
 /// Where input i of every program comes from: parameters, then coordinates,
 /// then velocities.
-fn input_value(d: &Ctx, i: usize) -> TokenStream {
+fn input_value(d: &Ctx, i: usize, params: &TokenStream) -> TokenStream {
     let np = d.model.params.len();
     let nq = d.model.coordinates.len();
     if i < np {
         let p = ident(&d.model.params[i].name);
-        quote! { self.params.#p }
+        quote! { #params.#p }
     } else if i < np + nq {
         let k = Literal::usize_unsuffixed(i - np);
         quote! { q[#k] }
@@ -125,7 +198,7 @@ fn slot(d: &Ctx, p: &Program, s: Slot) -> TokenStream {
 fn instr(d: &Ctx, p: &Program, ins: &Instr) -> TokenStream {
     let (dst, value) = match ins {
         Instr::Add(o, s) => (*o, join(s.iter().map(|&x| slot(d, p, x)), quote! { + })),
-        Instr::Mul(o, s) => (*o, product(d, p, s)),
+        Instr::Mul(o, s) => (*o, product(d, p, None, s)),
         Instr::Pow(o, s, n) => (*o, pow(d, slot(d, p, *s), *n)),
         Instr::Powf(o, s, x) => (*o, powf(d, slot(d, p, *s), *x)),
         Instr::Fun(o, f, s) => {
@@ -140,19 +213,25 @@ fn instr(d: &Ctx, p: &Program, ins: &Instr) -> TokenStream {
     quote! { let #dst: #real = #value; }
 }
 
-/// A product; a factor −1 becomes a negation.
-fn product(d: &Ctx, p: &Program, factors: &[Slot]) -> TokenStream {
+/// A product of `first` (if any) and `factors`; a factor −1 becomes a
+/// negation.
+fn product(d: &Ctx, p: &Program, first: Option<TokenStream>, factors: &[Slot]) -> TokenStream {
     let minus_one = |s: &Slot| matches!(s, Slot::Const(i) if p.consts[*i] == -1.0);
-    let rest: Vec<Slot> = factors.iter().copied().filter(|s| !minus_one(s)).collect();
-    let negations = factors.len() - rest.len();
-    if rest.is_empty() {
+    let rest: Vec<TokenStream> = factors
+        .iter()
+        .filter(|s| !minus_one(s))
+        .map(|&x| slot(d, p, x))
+        .collect();
+    let negations = factors.iter().filter(|s| minus_one(s)).count();
+    let operands: Vec<TokenStream> = first.into_iter().chain(rest).collect();
+    if operands.is_empty() {
         return if negations % 2 == 1 {
             quote! { -1.0 }
         } else {
             quote! { 1.0 }
         };
     }
-    let prod = join(rest.iter().map(|&x| slot(d, p, x)), quote! { * });
+    let prod = join(operands.into_iter(), quote! { * });
     if negations % 2 == 1 {
         quote! { -(#prod) }
     } else {

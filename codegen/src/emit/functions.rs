@@ -5,7 +5,7 @@
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
-use super::body::{body, lit, real};
+use super::body::{self, Place, lit, real};
 use super::{Ctx, Scalar, doc_attr, ident};
 use crate::derive::{Function, WallDerivation};
 use crate::ir::camel;
@@ -28,6 +28,7 @@ pub(super) fn inherent_impl(d: &Ctx) -> TokenStream {
     let vels = &d.model.velocities;
     let pnames = d.model.params.iter().map(|p| &p.name);
     let variants = d.walls.iter().map(|w| format_ident!("{}", camel(&w.name)));
+    let precompute = precompute(d);
     quote! {
         impl #ty {
             /// The model's name, as in its file.
@@ -53,11 +54,41 @@ pub(super) fn inherent_impl(d: &Ctx) -> TokenStream {
             #[allow(clippy::approx_constant)]
             pub const INITIAL_VELOCITIES: [#real; #nn] = [#(#init_v),*];
             /// The model with the given parameters.
-            pub const fn new(params: Params) -> Self {
-                Self { params }
+            pub fn new(params: Params) -> Self {
+                Self { params, pre: Self::precompute(&params) }
             }
+            /// The parameters in use.
+            pub fn params(&self) -> &Params {
+                &self.params
+            }
+            /// Sets every parameter (and recomputes the parameter-only values).
+            pub fn set_params(&mut self, params: Params) {
+                *self = Self::new(params);
+            }
+            #precompute
             #( #model_fns )*
             #( #walls )*
+        }
+    }
+}
+
+/// The once-per-parameter-set block: each function's parameter-only work,
+/// storing the values its per-call code reads.
+fn precompute(d: &Ctx) -> TokenStream {
+    let blocks = d.named_functions().into_iter().filter_map(|(name, f)| {
+        let split = d.split(&name);
+        let stmts = body::statements(d, &f.program, &split.once, Place::Once);
+        (split.stored > 0).then(|| quote! { { #stmts } })
+    });
+    let real = real(d);
+    let k = Literal::usize_unsuffixed(d.stored);
+    quote! {
+        /// The parameter-only values the functions read, from `params`.
+        #[allow(unused_variables, unused_mut, clippy::approx_constant)]
+        fn precompute(params: &Params) -> [#real; #k] {
+            let mut pre: [#real; #k] = [0.0; #k];
+            #( #blocks )*
+            pre
         }
     }
 }
@@ -181,7 +212,7 @@ fn args(d: &Ctx, inputs: Inputs) -> TokenStream {
 }
 
 /// An emitted method: doc, `#[inline]`, the arguments, the program's
-/// statements, then `result` of type `ret`.
+/// per-call statements, then `result` of type `ret`.
 fn function(
     d: &Ctx,
     name: &str,
@@ -193,7 +224,8 @@ fn function(
 ) -> TokenStream {
     let f = ident(name);
     let args = args(d, inputs);
-    let body = body(d, p);
+    let plan = &d.split(name).call;
+    let body = body::statements(d, p, plan, Place::Call);
     let doc = doc_attr(doc);
     quote! {
         #doc

@@ -14,6 +14,7 @@ mod body;
 mod functions;
 mod traits;
 
+use std::collections::HashMap;
 use std::ops::Deref;
 
 use proc_macro2::{Ident, Literal, Span, TokenStream};
@@ -22,6 +23,7 @@ use quote::{format_ident, quote};
 use crate::Generated;
 use crate::derive::Derivation;
 use crate::ir::camel;
+use crate::program::{OpCount, Split};
 
 use body::{lit, real};
 
@@ -44,11 +46,52 @@ pub struct Options {
     pub scalar: Scalar,
 }
 
-/// A derivation together with the emission options: what every emitting
-/// function sees (it reads as the derivation).
+/// A derivation together with the emission options and the split of each
+/// function into per-call and once-per-parameter-set work: what every
+/// emitting function sees (it reads as the derivation).
 struct Ctx<'a> {
     d: &'a Derivation,
     scalar: Scalar,
+    /// Each emitted function's split, by its name in the generated code.
+    splits: HashMap<String, Split>,
+    /// Precomputed values in all.
+    stored: usize,
+}
+
+impl<'a> Ctx<'a> {
+    fn new(d: &'a Derivation, scalar: Scalar) -> Self {
+        let params = d.model.params.len();
+        let mut splits = HashMap::new();
+        let mut stored = 0;
+        for (name, f) in d.named_functions() {
+            let split = f.program.split(params, stored);
+            stored += split.stored;
+            splits.insert(name, split);
+        }
+        Self {
+            d,
+            scalar,
+            splits,
+            stored,
+        }
+    }
+
+    /// The split of the function named `name` in the generated code.
+    fn split(&self, name: &str) -> &Split {
+        &self.splits[name]
+    }
+
+    /// Operations per call and once per parameter set, by function.
+    fn op_counts(&self) -> Vec<(String, OpCount, OpCount)> {
+        self.d
+            .named_functions()
+            .into_iter()
+            .map(|(name, f)| {
+                let (call, once) = self.split(&name).op_counts(&f.program);
+                (name, call, once)
+            })
+            .collect()
+    }
 }
 
 impl Deref for Ctx<'_> {
@@ -60,10 +103,7 @@ impl Deref for Ctx<'_> {
 
 /// The formatted Rust file for one model.
 pub fn file(d: &Derivation, options: Options) -> String {
-    let d = &Ctx {
-        d,
-        scalar: options.scalar,
-    };
+    let d = &Ctx::new(d, options.scalar);
     let tokens = model_tokens(d);
     let file: syn::File = match syn::parse2(tokens) {
         Ok(f) => f,
@@ -91,9 +131,13 @@ fn header(d: &Ctx) -> String {
     for line in m.doc.lines() {
         h.push_str(&format!("// {line}\n").replace("// \n", "//\n"));
     }
-    h.push_str(&format!("//\n// Operation counts ({}):\n", real(d)));
-    for (name, ops) in d.op_counts() {
-        h.push_str(&format!("//   {name:<28} {ops}\n"));
+    h.push_str(&format!(
+        "//\n// Operation counts per call ({}):\n",
+        real(d)
+    ));
+    let counts = d.op_counts();
+    for (name, call, _) in &counts {
+        h.push_str(&format!("//   {name:<28} {call}\n"));
     }
     for w in d.walls.iter().filter(|w| w.structured()) {
         h.push_str(&format!(
@@ -101,6 +145,13 @@ fn header(d: &Ctx) -> String {
             format!("{}_projector, _collide", w.name)
         ));
     }
+    let once = counts
+        .iter()
+        .fold(OpCount::default(), |sum, (_, _, once)| sum + *once);
+    h.push_str(&format!(
+        "//\n// Parameter-only work, done once when the parameters are set ({} values kept):\n//   {:<28} {once}\n",
+        d.stored, "all functions"
+    ));
     h.push('\n');
     h
 }
@@ -116,14 +167,25 @@ fn model_tokens(d: &Ctx) -> TokenStream {
         Scalar::F64 => traits::trait_impl(d),
         Scalar::F32 => TokenStream::new(),
     };
+    let real = real(d);
+    let k = Literal::usize_unsuffixed(d.stored);
     quote! {
         #params
         #walls
         #doc
-        #[derive(Clone, Copy, Debug, Default, PartialEq)]
+        #[derive(Clone, Copy, Debug, PartialEq)]
         pub struct #ty {
-            /// The parameters in use.
-            pub params: Params,
+            /// The parameters in use (set through `new`, `set_params` or
+            /// `set_parameter`, which keep `pre` up to date).
+            params: Params,
+            /// The parameter-only values the functions read.
+            pre: [#real; #k],
+        }
+        impl Default for #ty {
+            /// The model with the model file's parameter values.
+            fn default() -> Self {
+                Self::new(Params::default())
+            }
         }
         #inherent
         #trait_impl

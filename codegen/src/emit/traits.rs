@@ -42,13 +42,16 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
                 match index { #(#pidx => Some(self.params.#pidents),)* _ => None }
             }
             fn set_parameter(&mut self, index: usize, value: f64) -> bool {
-                match index { #(#pidx => { self.params.#pidents = value; true })* _ => false }
+                match index {
+                    #(#pidx => { self.params.#pidents = value; self.pre = Self::precompute(&self.params); true })*
+                    _ => false
+                }
             }
             #( #model )*
         }
         impl ::dalembert_runtime::FromParams for #ty {
             type Params = Params;
-            fn with_params(params: Params) -> Self { Self { params } }
+            fn with_params(params: Params) -> Self { Self::new(params) }
             fn params(&self) -> &Params { &self.params }
         }
         impl ::dalembert_runtime::Walls<#ql, #nl> for #ty {

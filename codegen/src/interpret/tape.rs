@@ -224,17 +224,6 @@ impl Builder {
     }
 }
 
-fn destination(ins: &Instr) -> Slot {
-    match ins {
-        Instr::Add(d, _)
-        | Instr::Mul(d, _)
-        | Instr::Pow(d, _, _)
-        | Instr::Powf(d, _, _)
-        | Instr::Fun(d, _, _)
-        | Instr::Assign(d, _) => *d,
-    }
-}
-
 impl Tape {
     /// Translates the instructions and orders them by level and kind.
     pub(super) fn new(p: &Program) -> Self {
@@ -271,7 +260,7 @@ impl Tape {
                 }
                 _ => b.translate(p, ins),
             };
-            b.current.insert(destination(ins), value);
+            b.current.insert(ins.dst(), value);
         }
         let outputs: Vec<u32> = (0..p.outputs).map(|i| b.read(Slot::Out(i))).collect();
         // Stable: within a level and kind, program order.

@@ -49,7 +49,7 @@ fn simulated_collision_on_a_line() {
     let c = hits[0];
     // They close 1.0 at 2.5 per unit time.
     assert!((c.t - 0.4).abs() < 1e-12 && (c.q[0] - 0.8).abs() < 1e-12);
-    let (m1, m2) = (body.params.m1, body.params.m2);
+    let (m1, m2) = (body.params().m1, body.params().m2);
     let e1 = ((m1 - m2) * 2.0 + 2.0 * m2 * -0.5) / (m1 + m2);
     let e2 = ((m2 - m1) * -0.5 + 2.0 * m1 * 2.0) / (m1 + m2);
     assert!((c.v_plus[0] - e1).abs() < 1e-12 && (c.v_plus[1] - e2).abs() < 1e-12);

@@ -6,15 +6,18 @@
 // velocity, w1, w2, w3 the angular velocity. No constraints in flight; at the
 // floor the contact point C = S - r e_z is at rest.
 //
-// Operation counts (f32):
+// Operation counts per call (f32):
 //   mass_matrix                  0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   kinetic_energy               5 add, 9 mul, 0 div, 0 fn (14 in all)
 //   constraints                  0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_normal                 0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_normal_velocity        0 add, 0 mul, 0 div, 0 fn (0 in all)
-//   floor_b_rows                 0 add, 1 mul, 0 div, 0 fn (1 in all)
-//   floor_projector              1 add, 10 mul, 1 div, 0 fn (12 in all)
-//   floor_collide                8 add, 19 mul, 1 div, 0 fn (28 in all)
+//   floor_b_rows                 0 add, 0 mul, 0 div, 0 fn (0 in all)
+//   floor_projector              0 add, 0 mul, 0 div, 0 fn (0 in all)
+//   floor_collide                4 add, 9 mul, 0 div, 0 fn (13 in all)
+//
+// Parameter-only work, done once when the parameters are set (17 values kept):
+//   all functions                4 add, 23 mul, 2 div, 0 fn (29 in all)
 
 /// Parameters of `ball_floor`; `Default` gives the model file's values.
 #[allow(non_snake_case)]
@@ -47,10 +50,19 @@ pub enum Wall {
 /// the collision instant, in the paper's velocities: v1, v2, v3 the centre's
 /// velocity, w1, w2, w3 the angular velocity. No constraints in flight; at the
 /// floor the contact point C = S - r e_z is at rest.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BallFloor {
-    /// The parameters in use.
-    pub params: Params,
+    /// The parameters in use (set through `new`, `set_params` or
+    /// `set_parameter`, which keep `pre` up to date).
+    params: Params,
+    /// The parameter-only values the functions read.
+    pre: [f32; 17],
+}
+impl Default for BallFloor {
+    /// The model with the model file's parameter values.
+    fn default() -> Self {
+        Self::new(Params::default())
+    }
 }
 impl BallFloor {
     /// The model's name, as in its file.
@@ -83,8 +95,87 @@ impl BallFloor {
     #[allow(clippy::approx_constant)]
     pub const INITIAL_VELOCITIES: [f32; 6] = [0f32, 0f32, 0f32, 0f32, 0f32, 0f32];
     /// The model with the given parameters.
-    pub const fn new(params: Params) -> Self {
-        Self { params }
+    pub fn new(params: Params) -> Self {
+        Self {
+            params,
+            pre: Self::precompute(&params),
+        }
+    }
+    /// The parameters in use.
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+    /// Sets every parameter (and recomputes the parameter-only values).
+    pub fn set_params(&mut self, params: Params) {
+        *self = Self::new(params);
+    }
+    /// The parameter-only values the functions read, from `params`.
+    #[allow(unused_variables, unused_mut, clippy::approx_constant)]
+    fn precompute(params: &Params) -> [f32; 17] {
+        let mut pre: [f32; 17] = [0.0; 17];
+        {
+            let i1: f32 = params.r;
+            let o10: f32 = -(i1);
+            pre[0] = o10;
+        }
+        {
+            let i0: f32 = params.m;
+            let i1: f32 = params.r;
+            let i2: f32 = params.J;
+            let o21: f32 = i1 * i1;
+            let o21: f32 = i0 * o21;
+            let o24: f32 = i2 + o21;
+            let o24: f32 = 1.0 / (o24);
+            let o0: f32 = i2 * o24;
+            pre[1] = o0;
+            let o19: f32 = i1 * o24;
+            let t4: f32 = -(o19);
+            let o4: f32 = i2 * t4;
+            pre[2] = o4;
+            let o9: f32 = i2 * o19;
+            pre[3] = o9;
+            let o19: f32 = i0 * o19;
+            pre[4] = o19;
+            let o21: f32 = o21 * o24;
+            pre[5] = o21;
+            let o24: f32 = i0 * t4;
+            pre[6] = o24;
+            let o7: f32 = o0;
+            pre[7] = o7;
+            let o28: f32 = o21;
+            pre[8] = o28;
+        }
+        {
+            let i0: f32 = params.m;
+            let i1: f32 = params.r;
+            let i2: f32 = params.J;
+            let t8: f32 = i1 * i1;
+            let t8: f32 = i0 * t8;
+            let t1: f32 = i2 + t8;
+            let t1: f32 = 1.0 / (t1);
+            let t7: f32 = -2f32 * t1;
+            let t5: f32 = i2 * t7;
+            let t2: f32 = 1f32 + t5;
+            pre[9] = t2;
+            let t1: f32 = i1 * t1;
+            let t1: f32 = 2f32 * t1;
+            let t3: f32 = i2 * t1;
+            pre[10] = t3;
+            let t5: f32 = i1 * t5;
+            pre[11] = t5;
+            let t6: f32 = i0 * i1 * t7;
+            pre[12] = t6;
+            let t8: f32 = t8 * t7;
+            let t7: f32 = 1f32 + t8;
+            pre[13] = t7;
+            let t8: f32 = i0 * t1;
+            pre[14] = t8;
+            let t4: f32 = t2;
+            pre[15] = t4;
+            let t9: f32 = t7;
+            pre[16] = t9;
+        }
+        pre
     }
     /// The mass matrix G(q).
     #[inline]
@@ -204,7 +295,7 @@ impl BallFloor {
     #[allow(unused_variables, clippy::approx_constant)]
     pub fn floor_b_rows(&self, q: &[f32; 0]) -> ([[f32; 6]; 6], usize) {
         let i1: f32 = self.params.r;
-        let o10: f32 = -(i1);
+        let o10: f32 = self.pre[0];
         let o0: f32 = 0f32;
         let o1: f32 = 0f32;
         let o2: f32 = 1f32;
@@ -238,27 +329,18 @@ impl BallFloor {
     #[inline]
     #[allow(unused_variables, clippy::approx_constant)]
     pub fn floor_projector(&self, q: &[f32; 0]) -> [[f32; 6]; 6] {
-        let i0: f32 = self.params.m;
-        let i1: f32 = self.params.r;
-        let i2: f32 = self.params.J;
-        let o21: f32 = i1 * i1;
-        let o21: f32 = i0 * o21;
-        let o24: f32 = i2 + o21;
-        let o24: f32 = 1.0 / (o24);
-        let o0: f32 = i2 * o24;
-        let o19: f32 = i1 * o24;
-        let t4: f32 = -(o19);
-        let o4: f32 = i2 * t4;
-        let o9: f32 = i2 * o19;
-        let o19: f32 = i0 * o19;
-        let o21: f32 = o21 * o24;
-        let o24: f32 = i0 * t4;
+        let o0: f32 = self.pre[1];
+        let o4: f32 = self.pre[2];
+        let o9: f32 = self.pre[3];
+        let o19: f32 = self.pre[4];
+        let o21: f32 = self.pre[5];
+        let o24: f32 = self.pre[6];
         let o1: f32 = 0f32;
         let o2: f32 = 0f32;
         let o3: f32 = 0f32;
         let o5: f32 = 0f32;
         let o6: f32 = 0f32;
-        let o7: f32 = o0;
+        let o7: f32 = self.pre[7];
         let o8: f32 = 0f32;
         let o10: f32 = 0f32;
         let o11: f32 = 0f32;
@@ -275,7 +357,7 @@ impl BallFloor {
         let o25: f32 = 0f32;
         let o26: f32 = 0f32;
         let o27: f32 = 0f32;
-        let o28: f32 = o21;
+        let o28: f32 = self.pre[8];
         let o29: f32 = 0f32;
         let o30: f32 = 0f32;
         let o31: f32 = 0f32;
@@ -296,41 +378,34 @@ impl BallFloor {
     #[inline]
     #[allow(unused_variables, clippy::approx_constant)]
     pub fn floor_collide(&self, q: &[f32; 0], v: &[f32; 6]) -> [f32; 6] {
-        let i0: f32 = self.params.m;
-        let i1: f32 = self.params.r;
-        let i2: f32 = self.params.J;
         let i3: f32 = v[0];
         let i4: f32 = v[1];
         let i5: f32 = v[2];
         let i6: f32 = v[3];
         let i7: f32 = v[4];
         let i8: f32 = v[5];
-        let t0: f32 = i1 * i1;
-        let o1: f32 = i0 * t0;
-        let o1: f32 = i2 + o1;
-        let o1: f32 = 1.0 / (o1);
-        let o3: f32 = i1 * o1;
-        let o4: f32 = 2f32 * o3;
-        let o0: f32 = i7 * o4;
-        let t5: f32 = -2f32 * o1;
-        let o2: f32 = i3 * t5;
-        let o0: f32 = o0 + o2;
-        let o2: f32 = i2 * o0;
-        let o0: f32 = i3 + o2;
-        let o2: f32 = i6 * o3;
-        let o3: f32 = i4 * o1;
-        let o1: f32 = o2 + o3;
-        let o3: f32 = -2f32 * o1;
-        let o2: f32 = i2 * o3;
-        let o1: f32 = i4 + o2;
-        let o2: f32 = -(i5);
-        let o3: f32 = i0 * i1 * o3;
-        let o3: f32 = i6 + o3;
-        let o4: f32 = i3 * o4;
-        let t0: f32 = i7 * t0 * t5;
-        let t5: f32 = o4 + t0;
-        let t0: f32 = i0 * t5;
-        let o4: f32 = i7 + t0;
+        let t2: f32 = self.pre[9];
+        let t3: f32 = self.pre[10];
+        let t5: f32 = self.pre[11];
+        let t6: f32 = self.pre[12];
+        let t7: f32 = self.pre[13];
+        let t8: f32 = self.pre[14];
+        let t4: f32 = self.pre[15];
+        let t9: f32 = self.pre[16];
+        let t10: f32 = t2 * i3;
+        let t11: f32 = t3 * i7;
+        let o0: f32 = t10 + t11;
+        let t12: f32 = t4 * i4;
+        let t13: f32 = t5 * i6;
+        let o1: f32 = t12 + t13;
+        let t14: f32 = -(i5);
+        let o2: f32 = t14;
+        let t15: f32 = t6 * i4;
+        let t16: f32 = t7 * i6;
+        let o3: f32 = t15 + t16;
+        let t17: f32 = t8 * i3;
+        let t18: f32 = t9 * i7;
+        let o4: f32 = t17 + t18;
         let o5: f32 = i8;
         [o0, o1, o2, o3, o4, o5]
     }

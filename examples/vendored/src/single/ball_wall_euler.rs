@@ -13,23 +13,26 @@
 // ball towards the wall; rolling, its centre accelerates at -m*a*r^2/J' with
 // J' = J + m*r^2.
 //
-// Operation counts (f32):
+// Operation counts per call (f32):
 //   mass_matrix                  0 add, 1 mul, 0 div, 1 fn (2 in all)
 //   kinetic_energy               5 add, 10 mul, 0 div, 1 fn (16 in all)
-//   potential                    1 add, 3 mul, 0 div, 0 fn (4 in all)
+//   potential                    1 add, 2 mul, 0 div, 0 fn (3 in all)
 //   constraints                  0 add, 5 mul, 0 div, 3 fn (8 in all)
 //   holonomic                    0 add, 0 mul, 0 div, 0 fn (0 in all)
-//   forcing                      17 add, 42 mul, 0 div, 4 fn (63 in all)
+//   forcing                      17 add, 41 mul, 0 div, 4 fn (62 in all)
 //   constraint_drift             4 add, 15 mul, 0 div, 4 fn (23 in all)
-//   accelerations                10 add, 30 mul, 2 div, 4 fn (46 in all)
+//   accelerations                9 add, 23 mul, 1 div, 4 fn (37 in all)
 //   initial_state                0 add, 1 mul, 0 div, 0 fn (1 in all)
-//   wall_surface                 1 add, 1 mul, 0 div, 0 fn (2 in all)
+//   wall_surface                 1 add, 0 mul, 0 div, 0 fn (1 in all)
 //   wall_normal                  0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   wall_normal_velocity         0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   wall_surface_hessian         0 add, 0 mul, 0 div, 0 fn (0 in all)
-//   wall_b_rows                  0 add, 7 mul, 0 div, 4 fn (11 in all)
-//   wall_projector               16 add, 47 mul, 2 div, 4 fn (69 in all)
-//   wall_collide                 31 add, 74 mul, 2 div, 4 fn (111 in all)
+//   wall_b_rows                  0 add, 6 mul, 0 div, 4 fn (10 in all)
+//   wall_projector               15 add, 39 mul, 1 div, 4 fn (59 in all)
+//   wall_collide                 29 add, 68 mul, 1 div, 4 fn (102 in all)
+//
+// Parameter-only work, done once when the parameters are set (23 values kept):
+//   all functions                4 add, 25 mul, 3 div, 0 fn (32 in all)
 
 /// Parameters of `ball_wall_euler`; `Default` gives the model file's values.
 #[allow(non_snake_case)]
@@ -75,10 +78,19 @@ pub enum Wall {
 /// A uniform horizontal force m*a along -x (potential m*a*x) drives the rolling
 /// ball towards the wall; rolling, its centre accelerates at -m*a*r^2/J' with
 /// J' = J + m*r^2.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BallWallEuler {
-    /// The parameters in use.
-    pub params: Params,
+    /// The parameters in use (set through `new`, `set_params` or
+    /// `set_parameter`, which keep `pre` up to date).
+    params: Params,
+    /// The parameter-only values the functions read.
+    pre: [f32; 23],
+}
+impl Default for BallWallEuler {
+    /// The model with the model file's parameter values.
+    fn default() -> Self {
+        Self::new(Params::default())
+    }
 }
 impl BallWallEuler {
     /// The model's name, as in its file.
@@ -110,8 +122,106 @@ impl BallWallEuler {
     #[allow(clippy::approx_constant)]
     pub const INITIAL_VELOCITIES: [f32; 5] = [-0.5f32, 0f32, 2f32, 0f32, 1f32];
     /// The model with the given parameters.
-    pub const fn new(params: Params) -> Self {
-        Self { params }
+    pub fn new(params: Params) -> Self {
+        Self {
+            params,
+            pre: Self::precompute(&params),
+        }
+    }
+    /// The parameters in use.
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+    /// Sets every parameter (and recomputes the parameter-only values).
+    pub fn set_params(&mut self, params: Params) {
+        *self = Self::new(params);
+    }
+    /// The parameter-only values the functions read, from `params`.
+    #[allow(unused_variables, unused_mut, clippy::approx_constant)]
+    fn precompute(params: &Params) -> [f32; 23] {
+        let mut pre: [f32; 23] = [0.0; 23];
+        {
+            let i1: f32 = params.r;
+            let i3: f32 = params.g;
+            let t0: f32 = i1 * i3;
+            pre[0] = t0;
+        }
+        {
+            let i0: f32 = params.m;
+            let i4: f32 = params.a;
+            let o0: f32 = i0 * i4;
+            pre[1] = o0;
+        }
+        {
+            let i0: f32 = params.m;
+            let i1: f32 = params.r;
+            let i2: f32 = params.J;
+            let i4: f32 = params.a;
+            let t0: f32 = i1 * i1;
+            let t0: f32 = i0 * t0;
+            pre[2] = t0;
+            let t1: f32 = i2 + t0;
+            let t1: f32 = 1.0 / (t1);
+            let t1: f32 = -(t1);
+            pre[3] = t1;
+            let o0: f32 = i4 * t0 * t1;
+            pre[4] = o0;
+            let o2: f32 = i0 * i4;
+            pre[5] = o2;
+            pre[6] = i0 * i1;
+        }
+        {
+            let i1: f32 = params.r;
+            let o0: f32 = -(i1);
+            pre[7] = o0;
+        }
+        {
+            let i1: f32 = params.r;
+            let o17: f32 = -(i1);
+            pre[8] = o17;
+        }
+        {
+            let i0: f32 = params.m;
+            let i1: f32 = params.r;
+            let i2: f32 = params.J;
+            let o21: f32 = i1 * i1;
+            let o21: f32 = i0 * o21;
+            pre[9] = o21;
+            let t1: f32 = i2 * 2f32;
+            pre[10] = t1;
+            let o22: f32 = o21 + t1;
+            let o22: f32 = 1.0 / (o22);
+            pre[11] = o22;
+            let o23: f32 = i2 * o22;
+            pre[12] = o23;
+            let o6: f32 = 2f32 * o23;
+            pre[13] = o6;
+            let o9: f32 = i1 * o23;
+            pre[14] = o9;
+            let o7: f32 = -(o9);
+            pre[15] = o7;
+            let o18: f32 = i0 * i1;
+            pre[16] = o18;
+        }
+        {
+            let i0: f32 = params.m;
+            let i1: f32 = params.r;
+            let i2: f32 = params.J;
+            let t1: f32 = i1 * i1;
+            let t1: f32 = i0 * t1;
+            pre[17] = t1;
+            let t2: f32 = i2 * 2f32;
+            let t2: f32 = t1 + t2;
+            let t2: f32 = 1.0 / (t2);
+            pre[18] = t2;
+            pre[19] = -(i1);
+            let t13: f32 = -2f32 * t2;
+            pre[20] = t13;
+            let t16: f32 = i0 * i1;
+            pre[21] = t16;
+            pre[22] = i2 + t1;
+        }
+        pre
     }
     /// The mass matrix G(q).
     #[inline]
@@ -187,11 +297,9 @@ impl BallWallEuler {
     #[allow(unused_variables, clippy::approx_constant)]
     pub fn potential(&self, q: &[f32; 5]) -> f32 {
         let i0: f32 = self.params.m;
-        let i1: f32 = self.params.r;
-        let i3: f32 = self.params.g;
         let i4: f32 = self.params.a;
         let i5: f32 = q[0];
-        let t0: f32 = i1 * i3;
+        let t0: f32 = self.pre[0];
         let o0: f32 = i4 * i5;
         let t0: f32 = t0 + o0;
         let o0: f32 = i0 * t0;
@@ -240,15 +348,13 @@ impl BallWallEuler {
     #[inline]
     #[allow(unused_variables, clippy::approx_constant)]
     pub fn forcing(&self, q: &[f32; 5], v: &[f32; 5]) -> [f32; 5] {
-        let i0: f32 = self.params.m;
         let i2: f32 = self.params.J;
-        let i4: f32 = self.params.a;
         let i7: f32 = q[2];
         let i8: f32 = q[3];
         let i12: f32 = v[2];
         let i13: f32 = v[3];
         let i14: f32 = v[4];
-        let o0: f32 = i0 * i4;
+        let o0: f32 = self.pre[1];
         let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
         let o4: f32 = sc0_sin;
         let t2: f32 = i14 * o4;
@@ -350,7 +456,6 @@ impl BallWallEuler {
     #[inline]
     #[allow(unused_variables, clippy::approx_constant)]
     pub fn accelerations(&self, q: &[f32; 5], v: &[f32; 5]) -> [f32; 5] {
-        let i0: f32 = self.params.m;
         let i1: f32 = self.params.r;
         let i2: f32 = self.params.J;
         let i4: f32 = self.params.a;
@@ -359,12 +464,9 @@ impl BallWallEuler {
         let i12: f32 = v[2];
         let i13: f32 = v[3];
         let i14: f32 = v[4];
-        let t0: f32 = i1 * i1;
-        let t0: f32 = i0 * t0;
-        let t1: f32 = i2 + t0;
-        let t1: f32 = 1.0 / (t1);
-        let t1: f32 = -(t1);
-        let o0: f32 = i4 * t0 * t1;
+        let t0: f32 = self.pre[2];
+        let t1: f32 = self.pre[3];
+        let o0: f32 = self.pre[4];
         let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
         let o3: f32 = sc0_sin;
         let t4: f32 = t0 * o3;
@@ -375,7 +477,7 @@ impl BallWallEuler {
         let t4: f32 = sc1_cos;
         let o4: f32 = sc0_cos;
         let o4: f32 = -(o4);
-        let o2: f32 = i0 * i4;
+        let o2: f32 = self.pre[5];
         let t4: f32 = i1 * t4;
         let t4: f32 = o2 * t4;
         let o2: f32 = o4 * t4;
@@ -393,7 +495,7 @@ impl BallWallEuler {
         let t9: f32 = sc1_sin;
         let t9: f32 = i4 * t9;
         let o3: f32 = o3 + t9;
-        let t9: f32 = i0 * i1 * o3;
+        let t9: f32 = self.pre[6] * o3;
         let o3: f32 = i2 * t8;
         let t8: f32 = t9 + o3;
         let o3: f32 = t1 * t8;
@@ -428,9 +530,8 @@ impl BallWallEuler {
     #[inline]
     #[allow(unused_variables, clippy::approx_constant)]
     pub fn wall_surface(&self, q: &[f32; 5]) -> f32 {
-        let i1: f32 = self.params.r;
         let i5: f32 = q[0];
-        let o0: f32 = -(i1);
+        let o0: f32 = self.pre[7];
         let o0: f32 = i5 + o0;
         o0
     }
@@ -469,7 +570,7 @@ impl BallWallEuler {
         let i8: f32 = q[3];
         let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
         let o14: f32 = sc0_sin;
-        let o17: f32 = -(i1);
+        let o17: f32 = self.pre[8];
         let o8: f32 = o14 * o17;
         let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
         let o19: f32 = sc1_sin;
@@ -508,20 +609,16 @@ impl BallWallEuler {
     #[inline]
     #[allow(unused_variables, clippy::approx_constant)]
     pub fn wall_projector(&self, q: &[f32; 5]) -> [[f32; 5]; 5] {
-        let i0: f32 = self.params.m;
-        let i1: f32 = self.params.r;
         let i2: f32 = self.params.J;
         let i7: f32 = q[2];
         let i8: f32 = q[3];
-        let o21: f32 = i1 * i1;
-        let o21: f32 = i0 * o21;
-        let t1: f32 = i2 * 2f32;
-        let o22: f32 = o21 + t1;
-        let o22: f32 = 1.0 / (o22);
-        let o23: f32 = i2 * o22;
-        let o6: f32 = 2f32 * o23;
-        let o9: f32 = i1 * o23;
-        let o7: f32 = -(o9);
+        let o21: f32 = self.pre[9];
+        let t1: f32 = self.pre[10];
+        let o22: f32 = self.pre[11];
+        let o23: f32 = self.pre[12];
+        let o6: f32 = self.pre[13];
+        let o9: f32 = self.pre[14];
+        let o7: f32 = self.pre[15];
         let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
         let t7: f32 = sc0_cos;
         let o8: f32 = o9 * t7;
@@ -539,7 +636,7 @@ impl BallWallEuler {
         let t1: f32 = t1 * t10;
         let t1: f32 = t16 + t1;
         let t1: f32 = 1.0 / (t1);
-        let o18: f32 = i0 * i1;
+        let o18: f32 = self.pre[16];
         let t18: f32 = t1 * o18;
         let o11: f32 = -(o11 * t18);
         let t19: f32 = -(t9);
@@ -601,7 +698,6 @@ impl BallWallEuler {
     #[inline]
     #[allow(unused_variables, clippy::approx_constant)]
     pub fn wall_collide(&self, q: &[f32; 5], v: &[f32; 5]) -> [f32; 5] {
-        let i0: f32 = self.params.m;
         let i1: f32 = self.params.r;
         let i2: f32 = self.params.J;
         let i7: f32 = q[2];
@@ -612,11 +708,8 @@ impl BallWallEuler {
         let i13: f32 = v[3];
         let i14: f32 = v[4];
         let o0: f32 = -(i10);
-        let t1: f32 = i1 * i1;
-        let t1: f32 = i0 * t1;
-        let t2: f32 = i2 * 2f32;
-        let t2: f32 = t1 + t2;
-        let t2: f32 = 1.0 / (t2);
+        let t1: f32 = self.pre[17];
+        let t2: f32 = self.pre[18];
         let t3: f32 = i12 * 2f32 * t2;
         let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
         let t4: f32 = sc0_cos;
@@ -635,16 +728,16 @@ impl BallWallEuler {
         let t10: f32 = i1 * t9;
         let o2: f32 = sc1_cos;
         let t12: f32 = i2 * o2;
-        let t13: f32 = -(i1 * t12);
+        let t13: f32 = self.pre[19] * t12;
         let t10: f32 = t10 + t13;
-        let t13: f32 = -2f32 * t2;
+        let t13: f32 = self.pre[20];
         let t10: f32 = i14 * t10 * t13;
         let o1: f32 = i11 + o1 + t10;
         let t10: f32 = t1 * t7;
         let t14: f32 = 2f32 * o3;
         let t14: f32 = t10 + t14;
         let t15: f32 = 1.0 / (t14);
-        let t16: f32 = i0 * i1;
+        let t16: f32 = self.pre[21];
         let t17: f32 = t3 * t16;
         let t18: f32 = o2 * t17;
         let t19: f32 = t7 * t16;
@@ -677,7 +770,7 @@ impl BallWallEuler {
         let o4: f32 = -2f32 * o3;
         let o2: f32 = t18 + t10 + o4;
         let t15: f32 = i2 * t23;
-        let t7: f32 = i2 + t1 + t15;
+        let t7: f32 = self.pre[22] + t15;
         let t24: f32 = t13 * t7;
         let o3: f32 = 1f32 + t24;
         let t10: f32 = i13 * o3;

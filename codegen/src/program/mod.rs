@@ -5,7 +5,13 @@
 //! symbolic engine's evaluator optimisation produces it). It does not depend
 //! on the symbolic engine, so the emitter and tests can use it freely.
 
+mod hoist;
+mod linear;
+
 use std::collections::HashMap;
+
+pub use hoist::{Emit, Role, Split};
+pub use linear::Entry;
 
 /// Where a value lives.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -86,6 +92,30 @@ pub enum Instr {
     Fun(Slot, Func, Slot),
     /// dst = src
     Assign(Slot, Slot),
+}
+
+impl Instr {
+    /// Where it writes.
+    pub fn dst(&self) -> Slot {
+        match self {
+            Self::Add(o, _)
+            | Self::Mul(o, _)
+            | Self::Pow(o, _, _)
+            | Self::Powf(o, _, _)
+            | Self::Fun(o, _, _)
+            | Self::Assign(o, _) => *o,
+        }
+    }
+
+    /// What it reads.
+    pub fn sources(&self) -> &[Slot] {
+        match self {
+            Self::Add(_, s) | Self::Mul(_, s) => s,
+            Self::Pow(_, s, _) | Self::Powf(_, s, _) | Self::Fun(_, _, s) | Self::Assign(_, s) => {
+                core::slice::from_ref(s)
+            }
+        }
+    }
 }
 
 /// A straight-line program.
@@ -190,23 +220,16 @@ impl Program {
         // (source value) → (index of its sin, index of its cos)
         let mut calls: HashMap<(Slot, usize), (Option<usize>, Option<usize>)> = HashMap::new();
         for (i, ins) in self.instrs.iter().enumerate() {
-            let dst = match ins {
-                Instr::Add(o, _)
-                | Instr::Mul(o, _)
-                | Instr::Pow(o, _, _)
-                | Instr::Powf(o, _, _)
-                | Instr::Assign(o, _) => *o,
-                Instr::Fun(o, f, src) => {
-                    let value = (*src, writes.get(src).copied().unwrap_or(0));
-                    let entry = calls.entry(value).or_default();
-                    match f {
-                        Func::Sin if entry.0.is_none() => entry.0 = Some(i),
-                        Func::Cos if entry.1.is_none() => entry.1 = Some(i),
-                        _ => {}
-                    }
-                    *o
+            let dst = ins.dst();
+            if let Instr::Fun(_, f, src) = ins {
+                let value = (*src, writes.get(src).copied().unwrap_or(0));
+                let entry = calls.entry(value).or_default();
+                match f {
+                    Func::Sin if entry.0.is_none() => entry.0 = Some(i),
+                    Func::Cos if entry.1.is_none() => entry.1 = Some(i),
+                    _ => {}
                 }
-            };
+            }
             *writes.entry(dst).or_default() += 1;
         }
         let mut found: Vec<(usize, usize)> = calls
@@ -225,11 +248,19 @@ impl Program {
     /// The operations it performs (a power xⁿ counts |n| − 1 multiplications,
     /// and one division when n < 0).
     pub fn op_count(&self) -> OpCount {
+        self.op_count_by(|_, ins| Some(ins.sources().len()))
+    }
+
+    /// The operations when `operands` says, for each instruction (by index),
+    /// with how many operands a sum or product is computed (`None`: not at
+    /// all).
+    pub fn op_count_by(&self, operands: impl Fn(usize, &Instr) -> Option<usize>) -> OpCount {
         let mut c = OpCount::default();
-        for ins in &self.instrs {
+        for (i, ins) in self.instrs.iter().enumerate() {
+            let Some(k) = operands(i, ins) else { continue };
             match ins {
-                Instr::Add(_, s) => c.add += s.len().saturating_sub(1),
-                Instr::Mul(_, s) => c.mul += s.len().saturating_sub(1),
+                Instr::Add(..) => c.add += k.saturating_sub(1),
+                Instr::Mul(..) => c.mul += k.saturating_sub(1),
                 Instr::Pow(_, _, n) => {
                     c.mul += (n.unsigned_abs() as usize).saturating_sub(1);
                     if *n < 0 {
