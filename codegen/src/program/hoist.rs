@@ -127,14 +127,28 @@ impl Program {
         let (mut in_call, mut in_once) = (vec![false; n], vec![false; n]);
         let mut stored = 0;
         let finals = self.final_writers();
+        // A copy of a parameter value is that value: it shares its stored
+        // slot rather than taking one of its own.
+        let mut same: Vec<usize> = (0..n).collect();
+        let mut slot: Vec<Option<usize>> = vec![None; n];
         for (i, role) in roles.iter().enumerate() {
             match *role {
                 Role::Parameter { read } => {
                     in_once[i] = true;
+                    if let (Instr::Assign(..), Some(Some(o))) =
+                        (&self.instrs[i], origins[i].first())
+                        && matches!(roles[*o], Role::Parameter { .. })
+                    {
+                        same[i] = same[*o];
+                    }
                     if read {
-                        call[i] = Emit::Load(first + stored);
-                        once[i] = Emit::Store(first + stored);
-                        stored += 1;
+                        let owner = same[i];
+                        let k = *slot[owner].get_or_insert_with(|| {
+                            stored += 1;
+                            first + stored - 1
+                        });
+                        call[i] = Emit::Load(k);
+                        once[owner] = Emit::Store(k);
                     }
                 }
                 Role::Varying { leading } => {
@@ -369,5 +383,29 @@ mod tests {
         let ops = |add, mul, div, fun| OpCount { add, mul, div, fun };
         assert_eq!(call, ops(2, 4, 0, 1));
         assert_eq!(once, ops(0, 2, 1, 1));
+    }
+
+    /// Two outputs that copy one parameter value share its stored slot.
+    #[test]
+    fn copies_share_a_stored_value() {
+        use Emit::*;
+        let (m, x) = (Slot::Input(0), Slot::Input(1));
+        let p = Program {
+            inputs: 2,
+            consts: vec![],
+            instrs: vec![
+                Instr::Pow(Slot::Temp(0), m, -1),
+                Instr::Assign(Slot::Out(0), Slot::Temp(0)),
+                Instr::Assign(Slot::Out(1), Slot::Temp(0)),
+                Instr::Mul(Slot::Out(2), vec![Slot::Temp(0), x]),
+            ],
+            outputs: 3,
+        };
+        let split = p.split(1, 0);
+        assert_eq!(split.call, vec![Load(0), Load(0), Load(0), Compute]);
+        assert_eq!(split.once[0], Store(0));
+        assert_eq!(split.stored, 1);
+        let y = |m: f64, x: f64| p.eval(&[m, x]);
+        assert_eq!(y(4.0, 2.0), vec![0.25, 0.25, 0.5]);
     }
 }

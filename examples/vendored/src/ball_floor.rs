@@ -16,7 +16,7 @@
 //   floor_projector              0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_collide                4 add, 9 mul, 0 div, 0 fn (13 in all)
 //
-// Parameter-only work, done once when the parameters are set (17 values kept):
+// Parameter-only work, done once when the parameters are set (13 values kept):
 //   all functions                4 add, 23 mul, 2 div, 0 fn (29 in all)
 
 /// Parameters of `ball_floor`; `Default` gives the model file's values.
@@ -56,7 +56,7 @@ pub struct BallFloor {
     /// `set_parameter`, which keep `pre` up to date).
     params: Params,
     /// The parameter-only values the functions read.
-    pre: [f64; 17],
+    pre: [f64; 13],
 }
 impl Default for BallFloor {
     /// The model with the model file's parameter values.
@@ -111,8 +111,8 @@ impl BallFloor {
     }
     /// The parameter-only values the functions read, from `params`.
     #[allow(unused_variables, unused_mut, clippy::approx_constant)]
-    fn precompute(params: &Params) -> [f64; 17] {
-        let mut pre: [f64; 17] = [0.0; 17];
+    fn precompute(params: &Params) -> [f64; 13] {
+        let mut pre: [f64; 13] = [0.0; 13];
         {
             let i1: f64 = params.r;
             let o10: f64 = -(i1);
@@ -141,9 +141,7 @@ impl BallFloor {
             let o24: f64 = i0 * t4;
             pre[6] = o24;
             let o7: f64 = o0;
-            pre[7] = o7;
             let o28: f64 = o21;
-            pre[8] = o28;
         }
         {
             let i0: f64 = params.m;
@@ -156,24 +154,22 @@ impl BallFloor {
             let t7: f64 = -2f64 * t1;
             let t5: f64 = i2 * t7;
             let t2: f64 = 1f64 + t5;
-            pre[9] = t2;
+            pre[7] = t2;
             let t1: f64 = i1 * t1;
             let t1: f64 = 2f64 * t1;
             let t3: f64 = i2 * t1;
-            pre[10] = t3;
+            pre[8] = t3;
             let t5: f64 = i1 * t5;
-            pre[11] = t5;
+            pre[9] = t5;
             let t6: f64 = i0 * i1 * t7;
-            pre[12] = t6;
+            pre[10] = t6;
             let t8: f64 = t8 * t7;
             let t7: f64 = 1f64 + t8;
-            pre[13] = t7;
+            pre[11] = t7;
             let t8: f64 = i0 * t1;
-            pre[14] = t8;
+            pre[12] = t8;
             let t4: f64 = t2;
-            pre[15] = t4;
             let t9: f64 = t7;
-            pre[16] = t9;
         }
         pre
     }
@@ -340,7 +336,7 @@ impl BallFloor {
         let o3: f64 = 0f64;
         let o5: f64 = 0f64;
         let o6: f64 = 0f64;
-        let o7: f64 = self.pre[7];
+        let o7: f64 = self.pre[1];
         let o8: f64 = 0f64;
         let o10: f64 = 0f64;
         let o11: f64 = 0f64;
@@ -357,7 +353,7 @@ impl BallFloor {
         let o25: f64 = 0f64;
         let o26: f64 = 0f64;
         let o27: f64 = 0f64;
-        let o28: f64 = self.pre[8];
+        let o28: f64 = self.pre[5];
         let o29: f64 = 0f64;
         let o30: f64 = 0f64;
         let o31: f64 = 0f64;
@@ -384,14 +380,14 @@ impl BallFloor {
         let i6: f64 = v[3];
         let i7: f64 = v[4];
         let i8: f64 = v[5];
-        let t2: f64 = self.pre[9];
-        let t3: f64 = self.pre[10];
-        let t5: f64 = self.pre[11];
-        let t6: f64 = self.pre[12];
-        let t7: f64 = self.pre[13];
-        let t8: f64 = self.pre[14];
-        let t4: f64 = self.pre[15];
-        let t9: f64 = self.pre[16];
+        let t2: f64 = self.pre[7];
+        let t3: f64 = self.pre[8];
+        let t5: f64 = self.pre[9];
+        let t6: f64 = self.pre[10];
+        let t7: f64 = self.pre[11];
+        let t8: f64 = self.pre[12];
+        let t4: f64 = self.pre[7];
+        let t9: f64 = self.pre[11];
         let t10: f64 = t2 * i3;
         let t11: f64 = t3 * i7;
         let o0: f64 = t10 + t11;
