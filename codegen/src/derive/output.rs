@@ -4,7 +4,7 @@
 //! come from the same expressions.
 
 use crate::ir::Model;
-use crate::program::{OpCount, Program};
+use crate::program::Program;
 use crate::quantity::Quantity;
 
 /// Everything derived for one model.
@@ -117,14 +117,5 @@ impl Derivation {
                 .map(move |f| (format!("{}_{}", w.name, f.quantity.spec().name), f))
         });
         model.chain(walls).collect()
-    }
-
-    /// Operation counts of every emitted function, by its name in the
-    /// generated code.
-    pub fn op_counts(&self) -> Vec<(String, OpCount)> {
-        self.named_functions()
-            .into_iter()
-            .map(|(name, f)| (name, f.program.op_count()))
-            .collect()
     }
 }

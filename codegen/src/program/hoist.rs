@@ -120,13 +120,12 @@ impl Program {
     /// the once block, storing what the per-call code reads; constants and
     /// copies stay wherever something reads them (or they are outputs).
     pub fn split(&self, params: usize, first: usize) -> Split {
-        let roles = self.roles(params);
-        let origins = self.origins();
+        let (origins, finals) = (self.origins(), self.final_writers());
+        let roles = self.roles_from(params, &origins, &finals);
         let n = self.instrs.len();
         let (mut call, mut once) = (vec![Emit::Skip; n], vec![Emit::Skip; n]);
         let (mut in_call, mut in_once) = (vec![false; n], vec![false; n]);
         let mut stored = 0;
-        let finals = self.final_writers();
         // A copy of a parameter value is that value: it shares its stored
         // slot rather than taking one of its own.
         let mut same: Vec<usize> = (0..n).collect();
@@ -224,9 +223,18 @@ impl Program {
     /// model's parameters. Slots may be written more than once: a read
     /// refers to the latest write before it.
     pub fn roles(&self, params: usize) -> Vec<Role> {
-        let origins = self.origins();
+        self.roles_from(params, &self.origins(), &self.final_writers())
+    }
+
+    /// [`Program::roles`] from the program's origins and final writers.
+    fn roles_from(
+        &self,
+        params: usize,
+        origins: &[Vec<Option<usize>>],
+        finals: &[usize],
+    ) -> Vec<Role> {
         let mut roles: Vec<Role> = Vec::with_capacity(self.instrs.len());
-        for (ins, from) in self.instrs.iter().zip(&origins) {
+        for (ins, from) in self.instrs.iter().zip(origins) {
             let of = |s: &Slot, w: &Option<usize>, roles: &[Role]| match (*s, w) {
                 (Slot::Const(_), _) => Role::Constant,
                 (Slot::Input(k), _) if k < params => Role::Parameter { read: false },
@@ -266,7 +274,7 @@ impl Program {
             }
             roles.push(role);
         }
-        for w in self.final_writers() {
+        for &w in finals {
             if let Role::Parameter { read } = &mut roles[w] {
                 *read = true;
             }

@@ -40,19 +40,14 @@ impl Program {
     /// order, and v is inputs `v..v + n`.
     pub fn times_vector(&self, entries: &[Entry], n: usize, v: usize) -> Program {
         assert_eq!(entries.len(), n * n, "one entry per element of M");
-        let temps = |s: &Slot| match s {
-            Slot::Temp(k) => k + 1,
-            _ => 0,
-        };
+        // Temporaries are numbered past every one this program uses (only
+        // written slots matter: a temporary is written before it is read).
         let base = self
             .instrs
             .iter()
-            .flat_map(|ins| {
-                ins.sources()
-                    .iter()
-                    .chain([ins.dst()].iter())
-                    .map(temps)
-                    .collect::<Vec<_>>()
+            .filter_map(|ins| match ins.dst() {
+                Slot::Temp(k) => Some(k + 1),
+                _ => None,
             })
             .max()
             .unwrap_or(0);
