@@ -10,7 +10,12 @@
 //! - `generic_dynamic`: P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B with nalgebra's heap-allocated
 //!   dynamic matrices on every call, then (I − 2P)v.
 //!
-//! - `chain_collide/chain_N`: the n-link chain family's collision map.
+//! - `chain_collide/chain_N`: the n-link chain family's collision map as
+//!   generated (the form the generator found cheapest: its header says
+//!   which), and `chain_collide/chain_N_runtime_solve` the same map from the
+//!   generated G and B by the runtime's fixed-size Cholesky factorisation
+//!   and constrained solve (how structured walls were evaluated before the
+//!   generator wrote the elimination out).
 //!
 //! Every path runs over the same 1024 inputs in turn, after all paths are
 //! checked to agree on each; time is the thread's CPU time.
@@ -21,7 +26,7 @@ use std::hint::black_box;
 
 use criterion::{BenchmarkGroup, Criterion, criterion_group, criterion_main};
 use dalembert::models::{BallFloor, BallWall};
-use dalembert::runtime::linalg::{projector, reflect};
+use dalembert::runtime::linalg::{correction, projector, reflect};
 use dalembert::runtime::prelude::*;
 use nalgebra::{DMatrix, DVector};
 
@@ -226,17 +231,34 @@ fn section_3_2(c: &mut Criterion<ThreadCpuTime>) {
 }
 
 /// The n-link chain family: the collision map at the model file's initial
-/// configuration, n = 1…8 (closed forms for n ≤ 3, structured above), and
-/// chain_4 with its closed form for comparison.
+/// configuration, n = 1…8, generated and by the runtime's solve from G and
+/// B; both checked equal first.
 fn chains(c: &mut Criterion<ThreadCpuTime>) {
     fn one<M: Surfaces<N> + Default, const N: usize>(g: &mut BenchmarkGroup<'_, ThreadCpuTime>) {
         let m = M::default();
         let q = m.initial_coordinates();
         let v: [f64; N] = std::array::from_fn(|i| 0.3 - 0.1 * i as f64);
         let w = m.walls()[0];
-        assert!(m.collide(w, &q, &v).iter().all(|x| x.is_finite()));
+        let solve = |q: &[f64; N], v: &[f64; N]| -> [f64; N] {
+            let b = m.wall_rows(w, q);
+            let r = b.apply(v);
+            let d = correction(&m.mass_matrix(q), b.as_slice(), r.as_slice())
+                .expect("G > 0 and B of full rank");
+            std::array::from_fn(|i| v[i] - 2.0 * d[i])
+        };
+        let (generated, solved) = (m.collide(w, &q, &v), solve(&q, &v));
+        for (x, y) in generated.iter().zip(&solved) {
+            assert!(
+                (x - y).abs() <= 1e-12 * (1.0 + y.abs()),
+                "{}: {generated:?} vs {solved:?}",
+                m.name()
+            );
+        }
         g.bench_function(m.name(), |b| {
             b.iter(|| m.collide(w, black_box(&q), black_box(&v)))
+        });
+        g.bench_function(format!("{}_runtime_solve", m.name()), |b| {
+            b.iter(|| solve(black_box(&q), black_box(&v)))
         });
     }
     use dalembert::models::*;
@@ -245,7 +267,6 @@ fn chains(c: &mut Criterion<ThreadCpuTime>) {
     one::<Chain2, 2>(&mut g);
     one::<Chain3, 3>(&mut g);
     one::<Chain4, 4>(&mut g);
-    one::<Chain4Symbolic, 4>(&mut g);
     one::<Chain5, 5>(&mut g);
     one::<Chain6, 6>(&mut g);
     one::<Chain7, 7>(&mut g);

@@ -1,30 +1,58 @@
 //! The n-link chain family (models/chain_N.toml): the generator evaluates P
-//! in closed form for n ≤ 3 and structured (G and B generated, P v solved at
-//! run time) above. Both evaluations of the same model must agree, and the
-//! choice must be the documented one.
+//! in closed form for n ≤ 3 and structured (G and B generated, P solved at
+//! run time) above; the collision map is emitted in the cheapest form per
+//! call, which for n ≥ 2 is the elimination written out. Every evaluation
+//! of the same map must agree, and the choice must be the documented one.
 
-use dalembert::models::{Chain4, Chain4Symbolic};
-use dalembert::models::{chain_4, chain_4_symbolic};
+use dalembert::models::{Chain3, Chain4, Chain4Symbolic};
+use dalembert::models::{chain_3, chain_4, chain_4_symbolic};
+use dalembert::runtime::linalg::{correction, reflect};
 use dalembert::runtime::prelude::*;
 
 mod common;
 use common::lcg;
 
-/// chain_4 structured vs chain_4_symbolic (the same model with its closed-form
-/// P): P and the collision map agree at random configurations, velocities
-/// and parameters.
+/// Random parameters (0.5…1.5), configuration and velocity.
+fn case<M: Model<N, N>, const N: usize>(m: &mut M, s: &mut u64) -> ([f64; N], [f64; N]) {
+    for i in 0..m.parameter_names().len() {
+        assert!(m.set_parameter(i, 0.5 + lcg(s)));
+    }
+    let q = std::array::from_fn(|_| -3.0 + 6.0 * lcg(s));
+    let v = std::array::from_fn(|_| -2.0 + 4.0 * lcg(s));
+    (q, v)
+}
+
+/// The runtime's solve from G and B: v − 2G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹Bv.
+fn solved<M: Surfaces<N>, const N: usize>(m: &M, q: &[f64; N], v: &[f64; N]) -> [f64; N] {
+    let w = m.walls()[0];
+    let b = m.wall_rows(w, q);
+    let d = correction(&m.mass_matrix(q), b.as_slice(), b.apply(v).as_slice()).unwrap();
+    std::array::from_fn(|i| v[i] - 2.0 * d[i])
+}
+
+fn close<const N: usize>(a: &[f64; N], b: &[f64; N], scale: f64, what: &str) {
+    for i in 0..N {
+        assert!(
+            (a[i] - b[i]).abs() < 1e-11 * scale,
+            "{what}, component {i}: {a:?} vs {b:?}"
+        );
+    }
+}
+
+/// chain_4 structured vs chain_4_symbolic (the same model with its
+/// closed-form P): P agrees, and the generated collision map (by
+/// elimination) agrees with (I − 2P)v of the exact closed form and with the
+/// runtime's solve, at random configurations, velocities and parameters.
 #[test]
 fn structured_and_symbolic_evaluation_agree() {
     let mut s = 11;
     for _ in 0..500 {
         let mut a = Chain4::default();
         let mut b = Chain4Symbolic::default();
-        for i in 0..Chain4::PARAMETERS.len() {
-            let x = 0.5 + lcg(&mut s);
-            assert!(a.set_parameter(i, x) && b.set_parameter(i, x));
+        let (q, v) = case(&mut a, &mut s);
+        for i in 0..a.parameter_names().len() {
+            assert!(b.set_parameter(i, a.parameter(i).unwrap()));
         }
-        let q: [f64; 4] = std::array::from_fn(|_| -3.0 + 6.0 * lcg(&mut s));
-        let v: [f64; 4] = std::array::from_fn(|_| -2.0 + 4.0 * lcg(&mut s));
         let pa = a.projector(chain_4::Wall::Floor, &q);
         let pb = b.projector(chain_4_symbolic::Wall::Floor, &q);
         let scale = pb.iter().flatten().fold(1.0f64, |m, x| m.max(x.abs()));
@@ -38,12 +66,45 @@ fn structured_and_symbolic_evaluation_agree() {
                 );
             }
         }
+        let vs = v.iter().fold(1.0f64, |m, x| m.max(x.abs())) * scale;
+        let exact = reflect(&pb, &v);
         let va = a.collide(chain_4::Wall::Floor, &q, &v);
         let vb = b.collide(chain_4_symbolic::Wall::Floor, &q, &v);
-        let vs = v.iter().fold(1.0f64, |m, x| m.max(x.abs()));
-        for i in 0..4 {
-            assert!((va[i] - vb[i]).abs() < 1e-11 * vs * scale);
-        }
+        close(
+            &va,
+            &exact,
+            vs,
+            "chain_4 collide vs (I - 2P)v, P closed form",
+        );
+        close(&vb, &exact, vs, "chain_4_symbolic collide vs (I - 2P)v");
+        close(
+            &va,
+            &solved(&a, &q, &v),
+            vs,
+            "chain_4 collide vs runtime solve",
+        );
+    }
+}
+
+/// chain_3 keeps its closed-form P but collides by elimination: the two
+/// agree.
+#[test]
+fn elimination_agrees_with_the_closed_form() {
+    let mut s = 5;
+    for _ in 0..500 {
+        let mut m = Chain3::default();
+        let (q, v) = case(&mut m, &mut s);
+        let p = m.projector(chain_3::Wall::Floor, &q);
+        let scale = p.iter().flatten().fold(1.0f64, |m, x| m.max(x.abs()));
+        let vs = v.iter().fold(1.0f64, |m, x| m.max(x.abs())) * scale;
+        let got = m.collide(chain_3::Wall::Floor, &q, &v);
+        close(&got, &reflect(&p, &v), vs, "chain_3 collide vs (I - 2P)v");
+        close(
+            &got,
+            &solved(&m, &q, &v),
+            vs,
+            "chain_3 collide vs runtime solve",
+        );
     }
 }
 
@@ -61,6 +122,12 @@ fn the_generator_chooses_as_documented() {
         let structured = text.contains("structured: solved at run time from G and B");
         assert_eq!(structured, n > 3, "chain_{n}");
         assert!(text.contains("pub fn floor_collide"));
+        let form = if n == 1 {
+            "M v, M = I - 2P"
+        } else {
+            "floor_collide                elimination"
+        };
+        assert!(text.contains(form), "chain_{n}: {form}");
     }
     assert!(!read("chain_4_symbolic").contains("structured: solved at run time"));
 }

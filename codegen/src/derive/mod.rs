@@ -17,6 +17,7 @@
 
 mod build;
 mod checks;
+mod elimination;
 mod evaluate;
 pub mod inspect;
 mod lower;
@@ -30,7 +31,7 @@ use std::ops::Range;
 
 use symbolica::prelude::*;
 
-pub use output::{Derivation, Function, Geometry, Projection, WallDerivation};
+pub use output::{Choice, Derivation, Form, Function, Geometry, Projection, WallDerivation};
 pub use symbols::sample_configuration;
 
 use crate::diag::{Collector, ErrorKind, ModelErrors, Reported};
@@ -136,7 +137,7 @@ fn initial_state(
 }
 
 /// Turns expressions into the emitted functions of one model.
-struct Compiler {
+pub(crate) struct Compiler {
     inputs: Vec<Atom>,
     kind: Kind,
 }
@@ -163,7 +164,7 @@ impl Compiler {
 
     /// As [`Compiler::program`], where the model has the quantity (an
     /// instantaneous model has no motion and no surfaces).
-    fn applicable(
+    pub(crate) fn applicable(
         &self,
         cx: &mut Collector,
         quantity: Quantity,

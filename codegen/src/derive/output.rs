@@ -19,7 +19,7 @@ pub struct Derivation {
     /// The holonomic constraints h(q).
     pub holonomic: Vec<String>,
     /// q̈ in closed form, component by component, where G⁻¹ is exact and
-    /// the rows of A independent (else the run time solves numerically).
+    /// the rows of A independent.
     pub accelerations: Option<Vec<String>>,
     /// Per wall.
     pub walls: Vec<WallDerivation>,
@@ -63,6 +63,52 @@ pub enum Projection {
     Structured,
 }
 
+/// A way to evaluate an emitted solve per call: the collision map
+/// v⁺ = (I − 2P)v or the accelerations q̈.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Form {
+    /// M v with M = I − 2P computed once per parameter set (P free of q).
+    Linear,
+    /// The exact closed form (of (I − 2P)v, or of q̈ from the exact G⁻¹).
+    ClosedForm,
+    /// G = LDLᵀ and the constrained solve written out over one program
+    /// for G, the rows and the right-hand sides
+    /// ([`crate::program::Program::reflect_by_elimination`],
+    /// [`crate::program::Program::motion_by_elimination`]).
+    Elimination,
+}
+
+impl Form {
+    /// A short name.
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Linear => "linear",
+            Self::ClosedForm => "closed form",
+            Self::Elimination => "elimination",
+        }
+    }
+
+    /// A phrase for generated headers and reports.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::Linear => "M v, M = I - 2P kept with the parameters",
+            Self::ClosedForm => "the exact closed form",
+            Self::Elimination => "elimination (G = LDL^T and the solve written out)",
+        }
+    }
+}
+
+/// How an emitted solve is evaluated: the cheapest form, and the per-call
+/// cost of every form considered ([`crate::program::OpCount::cost`] of
+/// the per-call work, parameter-only work being done once).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Choice {
+    /// The form emitted.
+    pub form: Form,
+    /// Each form considered, with its cost.
+    pub costs: Vec<(Form, usize)>,
+}
+
 /// What was derived for one wall.
 #[derive(Debug, Clone)]
 pub struct WallDerivation {
@@ -81,8 +127,12 @@ pub struct WallDerivation {
     pub dropped: Vec<String>,
     /// P and the collision map.
     pub projection: Projection,
+    /// How the emitted collision map is evaluated, and why; `None` where
+    /// the run time solves it from G and B.
+    pub collision: Option<Choice>,
     /// The wall's emitted functions, in [`crate::quantity::TABLE`] order
-    /// (the projector and collision map only in closed form).
+    /// (the projector only in closed form; the collision map wherever
+    /// [`WallDerivation::collision`] is set).
     pub functions: Vec<Function>,
 }
 

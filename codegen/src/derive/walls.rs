@@ -6,9 +6,10 @@
 use symbolica::prelude::*;
 
 use super::checks::{self, WallRows};
+use super::elimination;
 use super::lower::Lowering;
 use super::mechanics::{Exact, Raw, RawWall};
-use super::output::{Function, Geometry, Projection, WallDerivation};
+use super::output::{Form, Function, Geometry, Projection, WallDerivation};
 use super::symbols::Symbols;
 use super::{Field, Rat, is_zero, rows_matrix, strings};
 use crate::diag::{Collector, ErrorKind, Reported};
@@ -88,6 +89,7 @@ fn wall(
                 .applicable(cx, quantity, &outputs, rows, &w.span)?,
         );
     }
+    let mut candidates = Vec::new();
     let projection = match &closed {
         Some((p, collide)) => {
             let flat: Vec<Atom> = p.iter().flatten().cloned().collect();
@@ -95,13 +97,15 @@ fn wall(
                 c.compile
                     .applicable(cx, Quantity::Projector, &flat, 0, &w.span)?,
             );
-            let linear = linear_collision(c, cx, p, &w.span)?;
-            functions.extend(match linear {
-                Some(f) => Some(f),
-                None => c
-                    .compile
-                    .applicable(cx, Quantity::Collide, collide, 0, &w.span)?,
-            });
+            if let Some(f) = linear_collision(c, cx, p, &w.span)? {
+                candidates.push((Form::Linear, f));
+            }
+            if let Some(f) = c
+                .compile
+                .applicable(cx, Quantity::Collide, collide, 0, &w.span)?
+            {
+                candidates.push((Form::ClosedForm, f));
+            }
             Projection::ClosedForm {
                 projector: strings(p),
                 collision: collide
@@ -112,6 +116,11 @@ fn wall(
         }
         None => Projection::Structured,
     };
+    if let Some(f) = elimination::collision(c.sym, c.exact, c.compile, cx, &b_atoms, &w.span)? {
+        candidates.push((Form::Elimination, f));
+    }
+    let collision = elimination::choose(sym.params.len(), candidates);
+    functions.extend(collision.as_ref().map(|(_, f)| f.clone()));
     let geometry = match sym.model.kind {
         Kind::Coordinates => Geometry::Surface(raw.surface.to_string()),
         Kind::Instantaneous => {
@@ -126,6 +135,7 @@ fn wall(
         b_origin: kept,
         dropped,
         projection,
+        collision: collision.map(|(choice, _)| choice),
         functions,
     }))
 }

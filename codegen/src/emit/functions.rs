@@ -1,6 +1,6 @@
 //! The model's inherent functions: one per row of the quantity table that
-//! the derivation filled in, plus the structured projector and collision
-//! map where P is solved at run time.
+//! the derivation filled in, plus the projector (and, where no program for
+//! it was derived, the collision map) solved at run time from G and B.
 
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
@@ -157,9 +157,10 @@ fn emit_function(d: &Ctx, f: &Function, wall: Option<&str>) -> TokenStream {
     function(d, &name, &doc, p, inputs, ret, result)
 }
 
-/// P and the collision map of a wall evaluated at run time from the
-/// generated G and B by the runtime's fixed-size factorisations (NaN where
-/// B loses rank, as a closed form would divide by zero there).
+/// P of a wall evaluated at run time from the generated G and B by the
+/// runtime's fixed-size factorisations (NaN where B loses rank, as a closed
+/// form would divide by zero there), and the collision map the same way
+/// where the derivation has no program for it.
 fn structured_fns(d: &Ctx, w: &WallDerivation) -> TokenStream {
     let (q, n) = dims(d);
     let (ql, nl) = (Literal::usize_unsuffixed(q), Literal::usize_unsuffixed(n));
@@ -173,6 +174,20 @@ fn structured_fns(d: &Ctx, w: &WallDerivation) -> TokenStream {
     let c_doc = doc_attr(&format!(
         "Wall `{name}`: the collision map v⁺ = v⁻ − 2G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹Bv⁻, solved at run time from G and B (structured evaluation)."
     ));
+    let collide_fn = w.collision.is_none().then(|| {
+        quote! {
+            #c_doc
+            #[inline]
+            pub fn #collide(&self, q: &[f64; #ql], v: &[f64; #nl]) -> [f64; #nl] {
+                let b = self.#rows(q);
+                let r = b.apply(v);
+                match ::dalembert_runtime::__private::correction(&self.mass_matrix(q), b.as_slice(), r.as_slice()) {
+                    Ok(d) => ::core::array::from_fn(|i| v[i] - 2.0 * d[i]),
+                    Err(_) => [f64::NAN; #nl],
+                }
+            }
+        }
+    });
     quote! {
         #p_doc
         #[inline]
@@ -181,16 +196,7 @@ fn structured_fns(d: &Ctx, w: &WallDerivation) -> TokenStream {
             ::dalembert_runtime::__private::projector(&self.mass_matrix(q), b.as_slice())
                 .unwrap_or([[f64::NAN; #nl]; #nl])
         }
-        #c_doc
-        #[inline]
-        pub fn #collide(&self, q: &[f64; #ql], v: &[f64; #nl]) -> [f64; #nl] {
-            let b = self.#rows(q);
-            let r = b.apply(v);
-            match ::dalembert_runtime::__private::correction(&self.mass_matrix(q), b.as_slice(), r.as_slice()) {
-                Ok(d) => ::core::array::from_fn(|i| v[i] - 2.0 * d[i]),
-                Err(_) => [f64::NAN; #nl],
-            }
-        }
+        #collide_fn
     }
 }
 

@@ -140,9 +140,12 @@ fn header(d: &Ctx) -> String {
         h.push_str(&format!("//   {name:<28} {call}\n"));
     }
     for w in d.walls.iter().filter(|w| w.structured()) {
+        let what = match w.collision {
+            Some(_) => format!("{}_projector", w.name),
+            None => format!("{}_projector, _collide", w.name),
+        };
         h.push_str(&format!(
-            "//   {:<28} structured: solved at run time from G and B\n",
-            format!("{}_projector, _collide", w.name)
+            "//   {what:<28} structured: solved at run time from G and B\n"
         ));
     }
     let once = counts
@@ -152,6 +155,31 @@ fn header(d: &Ctx) -> String {
         "//\n// Parameter-only work, done once when the parameters are set ({} values kept):\n//   {:<28} {once}\n",
         d.stored, "all functions"
     ));
+    let chosen: Vec<_> = d
+        .walls
+        .iter()
+        .filter_map(|w| {
+            let c = w.collision.as_ref()?;
+            Some((format!("{}_collide", w.name), c))
+        })
+        .collect();
+    if !chosen.is_empty() {
+        h.push_str(
+            "//\n// Solves, the cheapest form per call (cost: add + mul + 4 div + 20 fn):\n",
+        );
+    }
+    for (name, c) in chosen {
+        let costs: Vec<String> = c
+            .costs
+            .iter()
+            .map(|(form, cost)| format!("{} {cost}", form.label()))
+            .collect();
+        h.push_str(&format!(
+            "//   {name:<28} {} [{}]\n",
+            c.form.describe(),
+            costs.join(", ")
+        ));
+    }
     h.push('\n');
     h
 }

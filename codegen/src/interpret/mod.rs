@@ -73,9 +73,12 @@ struct WallPrograms {
     normal_velocity: Compiled,
     surface_hessian: Compiled,
     rows: Compiled,
-    /// P and (I − 2P)v in closed form; `None`: solved at run time from G
-    /// and B, as a generated model does.
-    closed_form: Option<(Compiled, Compiled)>,
+    /// P in closed form; `None`: solved at run time from G and B, as a
+    /// generated model does.
+    projector: Option<Compiled>,
+    /// The collision map's program (closed form, linear or elimination);
+    /// `None`: solved at run time from G and B, as a generated model does.
+    collide: Option<Compiled>,
 }
 
 /// Which wall of an [`Interpreted`] model: its index in file order.
@@ -175,13 +178,6 @@ impl<const N: usize> Interpreted<N> {
         let mut walls = Vec::with_capacity(d.walls.len());
         for w in &d.walls {
             let wall_fn = |q: Quantity| find(&w.functions, q).ok_or_else(|| missing(q.spec().name));
-            let closed_form = match (
-                find(&w.functions, Quantity::Projector),
-                find(&w.functions, Quantity::Collide),
-            ) {
-                (Some(p), Some(c)) => Some((p, c)),
-                _ => None,
-            };
             walls.push(WallPrograms {
                 name: w.name.clone(),
                 surface: wall_fn(Quantity::Surface)?,
@@ -189,7 +185,8 @@ impl<const N: usize> Interpreted<N> {
                 normal_velocity: wall_fn(Quantity::NormalVelocity)?,
                 surface_hessian: wall_fn(Quantity::SurfaceHessian)?,
                 rows: wall_fn(Quantity::WallRows)?,
-                closed_form,
+                projector: find(&w.functions, Quantity::Projector),
+                collide: find(&w.functions, Quantity::Collide),
             });
         }
         Ok(Self {
@@ -234,7 +231,8 @@ impl<const N: usize> Interpreted<N> {
                 &mut w.rows,
             ]
             .into_iter()
-            .chain(w.closed_form.as_mut().into_iter().flat_map(|(p, c)| [p, c]))
+            .chain(w.projector.as_mut())
+            .chain(w.collide.as_mut())
         });
         model.chain(walls)
     }
@@ -336,8 +334,8 @@ impl<const N: usize> Walls<N, N> for Interpreted<N> {
         self.rows(&self.wall(wall).rows, q)
     }
     fn projector(&self, wall: WallIndex, q: &[f64; N]) -> [[f64; N]; N] {
-        match &self.wall(wall).closed_form {
-            Some((p, _)) => self.matrix(p, q),
+        match &self.wall(wall).projector {
+            Some(p) => self.matrix(p, q),
             None => {
                 let b = self.wall_rows(wall, q);
                 __private::projector(&self.mass_matrix(q), b.as_slice())
@@ -346,8 +344,8 @@ impl<const N: usize> Walls<N, N> for Interpreted<N> {
         }
     }
     fn collide(&self, wall: WallIndex, q: &[f64; N], v: &[f64; N]) -> [f64; N] {
-        match &self.wall(wall).closed_form {
-            Some((_, c)) => self.vector(c, q, v),
+        match &self.wall(wall).collide {
+            Some(c) => self.vector(c, q, v),
             None => {
                 let b = self.wall_rows(wall, q);
                 let r = b.apply(v);

@@ -19,50 +19,15 @@ pub enum Entry {
     General,
 }
 
-impl Instr {
-    /// The instruction with every slot mapped by `f`.
-    fn map_slots(&self, f: impl Fn(Slot) -> Slot) -> Instr {
-        let all = |s: &[Slot]| s.iter().map(|&x| f(x)).collect();
-        match self {
-            Instr::Add(d, s) => Instr::Add(f(*d), all(s)),
-            Instr::Mul(d, s) => Instr::Mul(f(*d), all(s)),
-            Instr::Pow(d, s, n) => Instr::Pow(f(*d), f(*s), *n),
-            Instr::Powf(d, s, x) => Instr::Powf(f(*d), f(*s), *x),
-            Instr::Fun(d, g, s) => Instr::Fun(f(*d), *g, f(*s)),
-            Instr::Assign(d, s) => Instr::Assign(f(*d), f(*s)),
-        }
-    }
-}
-
 impl Program {
     /// y = M v for the n×n matrix M whose entries, row by row, are
     /// `entries`: this program's outputs are the `General` ones in that
     /// order, and v is inputs `v..v + n`.
     pub fn times_vector(&self, entries: &[Entry], n: usize, v: usize) -> Program {
         assert_eq!(entries.len(), n * n, "one entry per element of M");
-        // Temporaries are numbered past every one this program uses (only
-        // written slots matter: a temporary is written before it is read).
-        let base = self
-            .instrs
-            .iter()
-            .filter_map(|ins| match ins.dst() {
-                Slot::Temp(k) => Some(k + 1),
-                _ => None,
-            })
-            .max()
-            .unwrap_or(0);
         // The entries become temporaries after this program's own.
+        let (mut instrs, base) = self.outputs_as_temps();
         let entry = |k: usize| Slot::Temp(base + k);
-        let mut instrs: Vec<Instr> = self
-            .instrs
-            .iter()
-            .map(|ins| {
-                ins.map_slots(|s| match s {
-                    Slot::Out(k) => entry(k),
-                    other => other,
-                })
-            })
-            .collect();
         let mut consts = self.consts.clone();
         let mut constant = |x: f64| {
             let k = consts.iter().position(|c| *c == x).unwrap_or_else(|| {

@@ -5,11 +5,13 @@
 //! symbolic engine's evaluator optimisation produces it). It does not depend
 //! on the symbolic engine, so the emitter and tests can use it freely.
 
+mod elimination;
 mod hoist;
 mod linear;
 
 use std::collections::HashMap;
 
+pub use elimination::Layout;
 pub use hoist::{Emit, Role, Split};
 pub use linear::Entry;
 
@@ -118,6 +120,21 @@ impl Instr {
     }
 }
 
+impl Instr {
+    /// The instruction with every slot mapped by `f`.
+    pub(crate) fn map_slots(&self, f: impl Fn(Slot) -> Slot) -> Instr {
+        let all = |s: &[Slot]| s.iter().map(|&x| f(x)).collect();
+        match self {
+            Instr::Add(d, s) => Instr::Add(f(*d), all(s)),
+            Instr::Mul(d, s) => Instr::Mul(f(*d), all(s)),
+            Instr::Pow(d, s, n) => Instr::Pow(f(*d), f(*s), *n),
+            Instr::Powf(d, s, x) => Instr::Powf(f(*d), f(*s), *x),
+            Instr::Fun(d, g, s) => Instr::Fun(f(*d), *g, f(*s)),
+            Instr::Assign(d, s) => Instr::Assign(f(*d), f(*s)),
+        }
+    }
+}
+
 /// A straight-line program.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Program {
@@ -149,6 +166,14 @@ impl OpCount {
     pub fn total(&self) -> usize {
         self.add + self.mul + self.div + self.fun
     }
+
+    /// A rough cost in additions, for choosing between programs that
+    /// compute the same thing: a division counts 4 (its throughput is a
+    /// fraction of a multiplier's on current cores) and a function call 20
+    /// (libm's sin, cos, exp, log and sqrt take tens of cycles).
+    pub fn cost(&self) -> usize {
+        self.add + self.mul + 4 * self.div + 20 * self.fun
+    }
 }
 
 impl std::ops::Add for OpCount {
@@ -178,6 +203,34 @@ impl std::fmt::Display for OpCount {
 }
 
 impl Program {
+    /// This program's instructions with its outputs turned into temporaries
+    /// numbered past every temporary it writes (output k becomes
+    /// `Temp(base + k)`), and that base: the start of a longer program that
+    /// goes on from these values. Only written slots matter: a temporary
+    /// is written before it is read.
+    pub(crate) fn outputs_as_temps(&self) -> (Vec<Instr>, usize) {
+        let base = self
+            .instrs
+            .iter()
+            .filter_map(|ins| match ins.dst() {
+                Slot::Temp(k) => Some(k + 1),
+                _ => None,
+            })
+            .max()
+            .unwrap_or(0);
+        let instrs = self
+            .instrs
+            .iter()
+            .map(|ins| {
+                ins.map_slots(|s| match s {
+                    Slot::Out(k) => Slot::Temp(base + k),
+                    other => other,
+                })
+            })
+            .collect();
+        (instrs, base)
+    }
+
     /// Runs the program on `inputs`.
     pub fn eval(&self, inputs: &[f64]) -> Vec<f64> {
         let mut temps: Vec<f64> = Vec::new();

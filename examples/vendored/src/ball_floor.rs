@@ -18,6 +18,9 @@
 //
 // Parameter-only work, done once when the parameters are set (13 values kept):
 //   all functions                4 add, 23 mul, 2 div, 0 fn (29 in all)
+//
+// Solves, the cheapest form per call (cost: add + mul + 4 div + 20 fn):
+//   floor_collide                M v, M = I - 2P kept with the parameters [linear 13, closed form 20, elimination 23]
 
 /// Parameters of `ball_floor`; `Default` gives the model file's values.
 #[allow(non_snake_case)]

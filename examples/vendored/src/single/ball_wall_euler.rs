@@ -33,6 +33,9 @@
 //
 // Parameter-only work, done once when the parameters are set (23 values kept):
 //   all functions                4 add, 25 mul, 3 div, 0 fn (32 in all)
+//
+// Solves, the cheapest form per call (cost: add + mul + 4 div + 20 fn):
+//   wall_collide                 the exact closed form [closed form 181, elimination 220]
 
 /// Parameters of `ball_wall_euler`; `Default` gives the model file's values.
 #[allow(non_snake_case)]

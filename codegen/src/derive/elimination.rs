@@ -1,0 +1,81 @@
+//! Pass 4b: each wall's collision map written out by elimination, over one
+//! program for G and B, and the choice between it and the exact closed
+//! forms by per-call cost.
+
+use std::ops::Range;
+
+use symbolica::prelude::*;
+
+use super::mechanics::Exact;
+use super::output::{Choice, Form, Function};
+use super::symbols::Symbols;
+use super::{Compiler, is_zero};
+use crate::diag::{Collector, Reported};
+use crate::program::Layout;
+use crate::quantity::Quantity;
+
+/// The outputs of one program: the entries that are not identically zero,
+/// each placed once.
+#[derive(Default)]
+struct Outputs(Vec<Atom>);
+
+impl Outputs {
+    fn place(&mut self, a: &Atom) -> Option<usize> {
+        (!is_zero(a)).then(|| {
+            self.0.push(a.clone());
+            self.0.len() - 1
+        })
+    }
+
+    /// G's lower triangle and `rows`, placed.
+    fn layout(&mut self, exact: &Exact, rows: &[Vec<Atom>]) -> Layout {
+        let n = exact.g.len();
+        let mut g = Vec::with_capacity(n * (n + 1) / 2);
+        for i in 0..n {
+            for j in 0..=i {
+                g.push(self.place(&exact.g[i][j]));
+            }
+        }
+        let rows = rows
+            .iter()
+            .map(|r| r.iter().map(|a| self.place(a)).collect())
+            .collect();
+        Layout { n, g, rows }
+    }
+}
+
+/// A wall's collision map by elimination over B's rows `b`. `None` where
+/// the model has no such function or a pivot is structurally zero.
+pub fn collision(
+    sym: &Symbols,
+    exact: &Exact,
+    compile: &Compiler,
+    cx: &mut Collector,
+    b: &[Vec<Atom>],
+    span: &Range<usize>,
+) -> Result<Option<Function>, Reported> {
+    let mut outputs = Outputs::default();
+    let layout = outputs.layout(exact, b);
+    let Some(f) = compile.applicable(cx, Quantity::Collide, &outputs.0, 0, span)? else {
+        return Ok(None);
+    };
+    let v = sym.params.len() + sym.coords.len();
+    Ok(f.program
+        .reflect_by_elimination(&layout, v)
+        .map(|program| Function { program, ..f }))
+}
+
+/// The cheapest candidate per call (parameter-only work done once, as
+/// emitted), with every candidate's cost; the first listed wins a tie.
+pub fn choose(params: usize, candidates: Vec<(Form, Function)>) -> Option<(Choice, Function)> {
+    let costs: Vec<(Form, usize)> = candidates
+        .iter()
+        .map(|(form, f)| {
+            let split = f.program.split(params, 0);
+            (*form, split.op_counts(&f.program).0.cost())
+        })
+        .collect();
+    let best = (0..candidates.len()).min_by_key(|&k| costs[k].1)?;
+    let (form, f) = candidates.into_iter().nth(best)?;
+    Some((Choice { form, costs }, f))
+}
