@@ -63,18 +63,15 @@ pub enum Projection {
     Structured,
 }
 
-/// A way to evaluate an emitted solve per call: the collision map
-/// v⁺ = (I − 2P)v or the accelerations q̈.
+/// A way to evaluate a wall's collision map v⁺ = (I − 2P)v per call.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Form {
     /// M v with M = I − 2P computed once per parameter set (P free of q).
     Linear,
-    /// The exact closed form (of (I − 2P)v, or of q̈ from the exact G⁻¹).
+    /// The exact closed form of (I − 2P)v.
     ClosedForm,
-    /// G = LDLᵀ and the constrained solve written out over one program
-    /// for G, the rows and the right-hand sides
-    /// ([`crate::program::Program::reflect_by_elimination`],
-    /// [`crate::program::Program::motion_by_elimination`]).
+    /// G = LDLᵀ and the solve with B's rows written out over one program
+    /// for G and B ([`crate::program::Program::reflect_by_elimination`]).
     Elimination,
 }
 
@@ -98,7 +95,7 @@ impl Form {
     }
 }
 
-/// How an emitted solve is evaluated: the cheapest form, and the per-call
+/// How a collision map is evaluated: the cheapest form, and the per-call
 /// cost of every form considered ([`crate::program::OpCount::cost`] of
 /// the per-call work, parameter-only work being done once).
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -45,11 +45,7 @@ struct Writer {
 
 impl Writer {
     fn constant(&mut self, x: f64) -> Slot {
-        let k = self.consts.iter().position(|c| *c == x).unwrap_or_else(|| {
-            self.consts.push(x);
-            self.consts.len() - 1
-        });
-        Slot::Const(k)
+        super::constant(&mut self.consts, x)
     }
 
     fn temp(&mut self) -> Slot {
@@ -134,6 +130,14 @@ impl Writer {
         y
     }
 
+    /// D⁻¹ y.
+    fn divide(&mut self, f: &Ldl, y: &[Value]) -> Vec<Value> {
+        y.iter()
+            .zip(&f.inv)
+            .map(|(e, r)| self.product(&[*e, Some(*r)]))
+            .collect()
+    }
+
     /// L⁻ᵀ u.
     fn backward(&mut self, f: &Ldl, u: &[Value]) -> Vec<Value> {
         let m = u.len();
@@ -172,16 +176,10 @@ impl Writer {
         g: &[Value],
     ) -> Option<Vec<Value>> {
         let (n, k) = (lg.inv.len(), rows.len());
-        let scale = |w: &mut Self, y: &[Value]| -> Vec<Value> {
-            y.iter()
-                .zip(&lg.inv)
-                .map(|(e, r)| w.product(&[*e, Some(*r)]))
-                .collect()
-        };
         let y: Vec<Vec<Value>> = rows.iter().map(|r| self.forward(lg, r)).collect();
-        let z: Vec<Vec<Value>> = y.iter().map(|yr| scale(self, yr)).collect();
+        let z: Vec<Vec<Value>> = y.iter().map(|yr| self.divide(lg, yr)).collect();
         let yf = self.forward(lg, f);
-        let zf = scale(self, &yf);
+        let zf = self.divide(lg, &yf);
         let mut s = vec![vec![None; k]; k];
         for r in 0..k {
             for c in 0..=r {
@@ -197,11 +195,7 @@ impl Writer {
             })
             .collect();
         let c = self.forward(&schur, &rhs);
-        let c = c
-            .iter()
-            .zip(&schur.inv)
-            .map(|(e, r)| self.product(&[*e, Some(*r)]))
-            .collect::<Vec<_>>();
+        let c = self.divide(&schur, &c);
         let mu = self.backward(&schur, &c);
         let u: Vec<Value> = (0..n)
             .map(|i| {

@@ -29,14 +29,10 @@ impl Program {
         let (mut instrs, base) = self.outputs_as_temps();
         let entry = |k: usize| Slot::Temp(base + k);
         let mut consts = self.consts.clone();
-        let mut constant = |x: f64| {
-            let k = consts.iter().position(|c| *c == x).unwrap_or_else(|| {
-                consts.push(x);
-                consts.len() - 1
-            });
-            Slot::Const(k)
-        };
-        let (minus_one, zero) = (constant(-1.0), constant(0.0));
+        let (minus_one, zero) = (
+            super::constant(&mut consts, -1.0),
+            super::constant(&mut consts, 0.0),
+        );
         let mut next = base + self.outputs;
         let mut general = 0;
         for i in 0..n {

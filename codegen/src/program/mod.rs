@@ -328,6 +328,15 @@ impl Program {
     }
 }
 
+/// The slot of constant `x` in `consts`, added if it is not there yet.
+fn constant(consts: &mut Vec<f64>, x: f64) -> Slot {
+    let k = consts.iter().position(|c| *c == x).unwrap_or_else(|| {
+        consts.push(x);
+        consts.len() - 1
+    });
+    Slot::Const(k)
+}
+
 /// x^e as the emitted code computes it: a square root where e = ±½.
 pub fn powf(x: f64, e: f64) -> f64 {
     if e == 0.5 {
