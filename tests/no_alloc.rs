@@ -74,9 +74,17 @@ fn exercise_motion<M: Surfaces<N>, const N: usize>(m: &M) -> f64 {
     if let Ok(a) = dalembert::runtime::dynamics::accelerations(m, &q, &v) {
         s += a.qdd[0];
     }
+    let mut series = dalembert::runtime::taylor::Series::at(&q, &v);
+    let mut f = [0.0; dalembert::runtime::taylor::CAPACITY];
+    if m.taylor_series(&mut series, 20) {
+        s += series.q[0][20];
+    }
     for &w in m.walls() {
         s += m.surface(w, &q);
         s += m.surface_hessian(w, &q, &v).unwrap_or(0.0);
+        if m.surface_series(w, &series, &mut f) {
+            s += f[series.order];
+        }
     }
     s
 }
@@ -108,12 +116,12 @@ macro_rules! no_alloc_test {
 
 for_each_model!(no_alloc_test);
 
-/// The simulator, collisions included, with both integrators: the
+/// The simulator, collisions included, with every integrator: the
 /// §3.2.1 ball over some 20 bounces and the Cartesian pendulum (holonomic
 /// projection) against its wall.
 #[test]
 fn simulator_does_not_allocate() {
-    use dalembert::runtime::simulate::{Integrator, Rk4, Settings, Simulator, State};
+    use dalembert::runtime::simulate::{Integrator, Rk4, Settings, Simulator, State, Taylor};
     let ball = BallBounce::default();
     let r = ball.params().r;
     let q = [0.0, 0.0, r + 1.0, 0.0, std::f64::consts::FRAC_PI_2, 0.0];
@@ -122,7 +130,11 @@ fn simulator_does_not_allocate() {
         integrator: Integrator::Rk4(Rk4 { step: 1e-3 }),
         ..Settings::default()
     };
-    for settings in [Settings::default(), rk4] {
+    let taylor = Settings {
+        integrator: Integrator::Taylor(Taylor::default()),
+        ..Settings::default()
+    };
+    for settings in [Settings::default(), rk4, taylor] {
         let mut collisions = 0;
         let n = allocations_during(|| {
             let mut sim = Simulator::new(&ball, State { t: 0.0, q, v }, settings).unwrap();

@@ -12,7 +12,8 @@ use dalembert::for_each_model;
 use dalembert::models::*;
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
-    DormandPrince, Integrator, Residual, Rk4, Settings, Simulator, State, admissible, residual,
+    DormandPrince, Integrator, Residual, Rk4, Settings, Simulator, State, Taylor, admissible,
+    residual,
 };
 use dalembert_codegen::Derivation;
 use dalembert_codegen::interpret::Interpreted;
@@ -27,6 +28,10 @@ pub enum Method {
     DormandPrince,
     /// Classical Runge–Kutta with a fixed step (`--step`).
     Rk4,
+    /// Taylor's method on the model's generated series, collisions found on
+    /// the step's polynomial (`--tolerance`; models whose q̈ is in closed
+    /// form).
+    Taylor,
 }
 
 #[derive(Args, Debug)]
@@ -50,6 +55,10 @@ pub struct SimulateArgs {
     /// Absolute tolerance of the adaptive method.
     #[arg(long, default_value_t = 1e-12)]
     pub atol: f64,
+    /// Tolerance of Taylor's method (absolute below 1, relative above;
+    /// default: the unit roundoff of f64, 2^-53).
+    #[arg(long)]
+    pub tolerance: Option<f64>,
     /// NAME=VALUE for a parameter, a coordinate or a velocity (repeatable);
     /// the rest come from the model file (`[parameters]`, `[initial]`).
     #[arg(long = "set", value_name = "NAME=VALUE", value_parser = assignment)]
@@ -224,6 +233,13 @@ fn checked_spacing(args: &SimulateArgs) -> Result<f64, String> {
         Method::DormandPrince => {
             positive("--rtol", args.rtol)?;
             positive("--atol", args.atol)?;
+        }
+        Method::Taylor => {
+            if let Some(tol) = args.tolerance
+                && !(tol > 0.0 && tol < 1.0)
+            {
+                return Err(format!("--tolerance must be in (0, 1), not {tol}"));
+            }
         }
     }
     Ok(every)
@@ -438,6 +454,10 @@ fn settings(args: &SimulateArgs) -> Settings {
             rtol: args.rtol,
             atol: args.atol,
             max_step: f64::INFINITY,
+        }),
+        Method::Taylor => Integrator::Taylor(Taylor {
+            tolerance: args.tolerance.unwrap_or(Taylor::default().tolerance),
+            ..Taylor::default()
         }),
     };
     Settings {

@@ -21,6 +21,7 @@
 pub mod dynamics;
 pub mod linalg;
 pub mod simulate;
+pub mod taylor;
 
 /// Up to `N` rows of length `N`: a constraint matrix such as A(q) or B(q).
 ///

@@ -4,6 +4,7 @@
 //! An instantaneous model (`Q = 0`, the paper's §3) implements only the
 //! first two: it has no motion and no surfaces.
 
+use crate::taylor::{Coefficients, Series};
 use crate::{Rows, Values, linalg};
 
 /// What every model has: names, parameters, the mass matrix and the
@@ -139,6 +140,17 @@ pub trait Dynamics<const N: usize>: Model<N, N> {
         None
     }
 
+    /// The Taylor series of the motion through the state held at order 0
+    /// of `series` (q(t₀), q̇(t₀)): fills its coefficients of orders 1 to
+    /// `order` (at most [`crate::taylor::MAX_ORDER`]) and sets its order.
+    /// Generated models have it where q̈ is in closed form (the Taylor
+    /// transform of that program); `false` (the default) means the model
+    /// has none and the series is untouched.
+    fn taylor_series(&self, series: &mut Series<N>, order: usize) -> bool {
+        let _ = (series, order);
+        false
+    }
+
     /// Total energy T + V.
     fn energy(&self, q: &[f64; N], v: &[f64; N]) -> f64 {
         self.kinetic_energy(q, v) + self.potential(q)
@@ -158,5 +170,13 @@ pub trait Surfaces<const N: usize>: Dynamics<N> + Walls<N, N> {
     fn surface_hessian(&self, wall: Self::Wall, q: &[f64; N], v: &[f64; N]) -> Option<f64> {
         let _ = (wall, q, v);
         None
+    }
+
+    /// The Taylor coefficients of t ↦ f(q(t)) along `series` (see
+    /// [`Dynamics::taylor_series`]), orders 0 to `series.order`, into
+    /// `out`. `false` (the default) means the model has none.
+    fn surface_series(&self, wall: Self::Wall, series: &Series<N>, out: &mut Coefficients) -> bool {
+        let _ = (wall, series, out);
+        false
     }
 }

@@ -182,7 +182,7 @@ fn input_value(d: &Ctx, i: usize, params: &TokenStream) -> TokenStream {
     }
 }
 
-fn slot(d: &Ctx, p: &Program, s: Slot) -> TokenStream {
+pub(super) fn slot(d: &Ctx, p: &Program, s: Slot) -> TokenStream {
     let name = match s {
         Slot::Input(i) => format_ident!("i{i}"),
         Slot::Temp(i) => format_ident!("t{i}"),

@@ -29,6 +29,7 @@ pub(super) fn inherent_impl(d: &Ctx) -> TokenStream {
     let pnames = d.model.params.iter().map(|p| &p.name);
     let variants = d.walls.iter().map(|w| format_ident!("{}", camel(&w.name)));
     let precompute = precompute(d);
+    let series = super::taylor::functions(d);
     quote! {
         impl #ty {
             /// The model's name, as in its file.
@@ -68,6 +69,7 @@ pub(super) fn inherent_impl(d: &Ctx) -> TokenStream {
             #precompute
             #( #model_fns )*
             #( #walls )*
+            #series
         }
     }
 }

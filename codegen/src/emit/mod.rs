@@ -8,10 +8,12 @@
 //! - [`functions`]: the model's inherent functions, one per row of the
 //!   quantity table;
 //! - [`body`]: a straight-line program as Rust statements;
+//! - [`taylor`]: the Taylor-mode series of the motion and of each wall's f;
 //! - [`traits`]: the runtime trait, forwarding to the inherent functions.
 
 mod body;
 mod functions;
+mod taylor;
 mod traits;
 
 use std::collections::HashMap;
@@ -147,6 +149,21 @@ fn header(d: &Ctx) -> String {
         h.push_str(&format!(
             "//   {what:<28} structured: solved at run time from G and B\n"
         ));
+    }
+    if let Some((motion, walls)) = taylor::transforms(d) {
+        h.push_str("//\n// Taylor series, per order (series operations, of them convolutions):\n");
+        let (ops, loops) = taylor::counts(&motion);
+        h.push_str(&format!(
+            "//   {:<28} {ops} ops, {loops} convolutions\n",
+            "motion_series"
+        ));
+        for (w, t) in d.walls.iter().zip(&walls) {
+            let (ops, loops) = taylor::counts(t);
+            let name = format!("{}_surface_series", w.name);
+            h.push_str(&format!(
+                "//   {name:<28} {ops} ops, {loops} convolutions\n"
+            ));
+        }
     }
     let once = counts
         .iter()

@@ -67,15 +67,47 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
         return model_impl;
     }
     let (dynamics, surfaces) = (methods(Capability::Dynamics), methods(Capability::Surfaces));
+    let (motion_series, surface_series) = match super::taylor::transforms(d) {
+        Some(_) => {
+            let arms = d.walls.iter().zip(&variants).map(|(w, v)| {
+                let f = format_ident!("{}_surface_series", w.name);
+                quote! { Wall::#v => self.#f(series, out) }
+            });
+            (
+                quote! {
+                    #[inline]
+                    fn taylor_series(&self, series: &mut ::dalembert_runtime::taylor::Series<#nl>, order: usize) -> bool {
+                        self.motion_series(series, order);
+                        true
+                    }
+                },
+                quote! {
+                    #[inline]
+                    fn surface_series(
+                        &self,
+                        wall: Wall,
+                        series: &::dalembert_runtime::taylor::Series<#nl>,
+                        out: &mut ::dalembert_runtime::taylor::Coefficients,
+                    ) -> bool {
+                        match wall { #(#arms,)* }
+                        true
+                    }
+                },
+            )
+        }
+        None => (TokenStream::new(), TokenStream::new()),
+    };
     quote! {
         #model_impl
         impl ::dalembert_runtime::Dynamics<#nl> for #ty {
             fn initial_coordinates(&self) -> [f64; #ql] { self.initial_state().0 }
             fn initial_velocities(&self) -> [f64; #nl] { self.initial_state().1 }
             #( #dynamics )*
+            #motion_series
         }
         impl ::dalembert_runtime::Surfaces<#nl> for #ty {
             #( #surfaces )*
+            #surface_series
         }
     }
 }

@@ -14,10 +14,12 @@ mod tape;
 
 use std::cell::RefCell;
 
+use dalembert_runtime::taylor::{Coefficients, MAX_ORDER, Series};
 use dalembert_runtime::{__private, Dynamics, Model, Rows, Surfaces, Values, Walls};
 
 use crate::derive::{Derivation, Function};
 use crate::ir::Kind;
+use crate::program::{Evaluation, Transform};
 use crate::quantity::Quantity;
 use tape::Tape;
 
@@ -108,6 +110,10 @@ pub struct Interpreted<const N: usize> {
     forcing: Compiled,
     drift: Compiled,
     accelerations: Option<Compiled>,
+    /// The Taylor transforms of q̈ and of each wall's f, where q̈ is in
+    /// closed form (the generated model's `motion_series` and
+    /// `{wall}_surface_series` do the same operations).
+    series: Option<(Transform, Vec<Transform>)>,
     walls: Vec<WallPrograms>,
     indices: Vec<WallIndex>,
 }
@@ -189,7 +195,23 @@ impl<const N: usize> Interpreted<N> {
                 collide: find(&w.functions, Quantity::Collide),
             });
         }
+        let (np, nq) = (m.params.len(), m.coordinates.len());
+        let series = d
+            .function(Quantity::Accelerations)
+            .map(|a| {
+                let walls = d
+                    .walls
+                    .iter()
+                    .map(|w| {
+                        w.function(Quantity::Surface)
+                            .map(|f| f.program.taylor(np, nq))
+                    })
+                    .collect::<Option<Vec<_>>>()?;
+                Some((a.program.taylor(np, nq), walls))
+            })
+            .flatten();
         Ok(Self {
+            series,
             name: leak_names(std::iter::once(m.name.clone()))[0],
             coordinates: leak_names(m.coordinates.iter().cloned()),
             velocities: leak_names(m.velocities.iter().cloned()),
@@ -389,6 +411,21 @@ impl<const N: usize> Dynamics<N> for Interpreted<N> {
     fn closed_form_accelerations(&self, q: &[f64; N], v: &[f64; N]) -> Option<[f64; N]> {
         self.accelerations.as_ref().map(|c| self.vector(c, q, v))
     }
+    fn taylor_series(&self, series: &mut Series<N>, order: usize) -> bool {
+        let Some((motion, _)) = &self.series else {
+            return false;
+        };
+        let q: [f64; N] = std::array::from_fn(|i| series.q[i][0]);
+        let v: [f64; N] = std::array::from_fn(|i| series.v[i][0]);
+        let order = order.min(MAX_ORDER);
+        let e = motion.motion(&self.values, &q, &v, order);
+        for i in 0..N {
+            series.q[i] = e.q[i];
+            series.v[i] = e.v[i];
+        }
+        series.order = order;
+        true
+    }
 }
 
 impl<const N: usize> Surfaces<N> for Interpreted<N> {
@@ -397,5 +434,17 @@ impl<const N: usize> Surfaces<N> for Interpreted<N> {
     }
     fn surface_hessian(&self, wall: WallIndex, q: &[f64; N], v: &[f64; N]) -> Option<f64> {
         Some(self.scalar(&self.wall(wall).surface_hessian, q, v))
+    }
+    fn surface_series(&self, wall: WallIndex, series: &Series<N>, out: &mut Coefficients) -> bool {
+        let Some(t) = self.series.as_ref().and_then(|(_, w)| w.get(wall.0)) else {
+            return false;
+        };
+        let mut e = Evaluation {
+            q: series.q.to_vec(),
+            v: series.v.to_vec(),
+            temps: Vec::new(),
+        };
+        *out = t.along(&self.values, &mut e, series.order);
+        true
     }
 }

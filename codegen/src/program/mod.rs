@@ -8,12 +8,14 @@
 mod elimination;
 mod hoist;
 mod linear;
+mod taylor;
 
 use std::collections::HashMap;
 
 pub use elimination::Layout;
 pub use hoist::{Emit, Role, Split};
 pub use linear::Entry;
+pub use taylor::{Evaluation, Op, Series, Term, Transform};
 
 /// Where a value lives.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

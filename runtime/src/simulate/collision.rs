@@ -2,6 +2,7 @@
 //! method on f, checked (grazing, a singular wall, another wall at once),
 //! and resolved by the collision map v⁺ = (I − 2P)v⁻.
 
+use super::integrator::RungeKutta;
 use super::phase::{Phase, norm};
 use super::thresholds::{POLISH_STEPS, REVERSAL, TAYLOR_REACH};
 use super::{Collision, Located, SimError, Simulator, State};
@@ -13,15 +14,32 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     /// on from there.
     pub(super) fn collide(
         &mut self,
+        method: &RungeKutta,
         y0: &Phase<N>,
         t0: f64,
         located: Located<N>,
     ) -> Result<Collision<M::Wall, N>, SimError<M::Wall>> {
         let k = located.wall;
         let step = located.t_hi - t0;
-        let (tc, y) = self.polish(y0, t0, located)?;
+        let (tc, y) = self.polish(method, y0, t0, located)?;
+        let collision = self.land(k, tc, &y, t0, step)?;
+        self.f0 = self.rhs(tc, &self.phase())?;
+        Ok(collision)
+    }
+
+    /// The collision with wall `k` at (tc, y), found on a step of length
+    /// `step` from t0: checked, mapped, and the simulator's state set to
+    /// just after it (projected onto the constraints).
+    pub(super) fn land(
+        &mut self,
+        k: usize,
+        tc: f64,
+        y: &Phase<N>,
+        t0: f64,
+        step: f64,
+    ) -> Result<Collision<M::Wall, N>, SimError<M::Wall>> {
         let window = self.simultaneity_window(tc, step);
-        let collision = self.resolve(k, tc, &y, window)?;
+        let collision = self.resolve(k, tc, y, window)?;
         self.state = State {
             t: tc,
             q: y.q,
@@ -39,7 +57,6 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         }
         self.last_collision = Some(tc);
         self.project()?;
-        self.f0 = self.rhs(tc, &self.phase())?;
         Ok(collision)
     }
 
@@ -48,6 +65,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     /// staying in [t0, t_hi]: the instant and the state at the wall.
     fn polish(
         &mut self,
+        method: &RungeKutta,
         y0: &Phase<N>,
         t0: f64,
         located: Located<N>,
@@ -86,7 +104,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
                 };
                 (taylor, None)
             } else {
-                self.advance(y0, t0, next - t0)?
+                self.advance(method, y0, t0, next - t0)?
             };
             if m.surface(wall, &candidate.q).abs() >= f.abs() {
                 break;

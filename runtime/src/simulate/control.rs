@@ -2,7 +2,7 @@
 //! one is accepted (step-size control), and plain steps for locating a
 //! collision.
 
-use super::integrator::{Method, Trial};
+use super::integrator::{Method, RungeKutta, Trial};
 use super::phase::Phase;
 use super::thresholds::{FAILED_STEP_RETRIES, FAILED_STEP_SHRINK, SMALLEST_STEP_ULPS};
 use super::{SimError, Simulator, derivative};
@@ -13,32 +13,39 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     /// there when the method has it for free.
     pub(super) fn advance(
         &mut self,
+        method: &RungeKutta,
         y0: &Phase<N>,
         t0: f64,
         h: f64,
     ) -> Result<(Phase<N>, Option<Phase<N>>), SimError<M::Wall>> {
         let (model, stats, f0) = (self.model, &mut self.stats, self.f0);
         let mut rhs = |t: f64, y: &Phase<N>| derivative(model, stats, t, y);
-        self.settings.integrator.advance(&mut rhs, y0, &f0, t0, h)
+        method.advance(&mut rhs, y0, &f0, t0, h)
     }
 
     /// One step of length `h` from (t0, y0) without error control.
-    fn trial(&mut self, y0: &Phase<N>, t0: f64, h: f64) -> Result<Trial<N>, SimError<M::Wall>> {
+    fn trial(
+        &mut self,
+        method: &RungeKutta,
+        y0: &Phase<N>,
+        t0: f64,
+        h: f64,
+    ) -> Result<Trial<N>, SimError<M::Wall>> {
         let (model, stats, f0) = (self.model, &mut self.stats, self.f0);
         let mut rhs = |t: f64, y: &Phase<N>| derivative(model, stats, t, y);
-        self.settings.integrator.trial(&mut rhs, y0, &f0, t0, h)
+        method.trial(&mut rhs, y0, &f0, t0, h)
     }
 
     /// Trial steps of at most `limit` until one is accepted; returns its
     /// length.
     pub(super) fn accepted_trial(
         &mut self,
+        method: &RungeKutta,
         y0: &Phase<N>,
         t_end: f64,
         limit: f64,
     ) -> Result<(f64, Trial<N>), SimError<M::Wall>> {
         let t0 = self.state.t;
-        let method = self.settings.integrator;
         let mut rejected = false;
         let mut failures = 0;
         loop {
@@ -47,12 +54,12 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
                 return Err(SimError::StepTooSmall { t: t0, step: h });
             }
             if !method.adaptive() {
-                return Ok((h, self.trial(y0, t0, h)?));
+                return Ok((h, self.trial(method, y0, t0, h)?));
             }
             // A stage that lands on a singular or non-finite state may only
             // mean the step is too long: shrink it a few times before
             // reporting the error.
-            let trial = match self.trial(y0, t0, h) {
+            let trial = match self.trial(method, y0, t0, h) {
                 Ok(trial) => trial,
                 Err(SimError::Dynamics { .. }) if failures < FAILED_STEP_RETRIES => {
                     failures += 1;

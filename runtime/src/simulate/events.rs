@@ -2,7 +2,7 @@
 //! adaptive steps end there), and where a step actually crosses one,
 //! located on the dense output.
 
-use super::integrator::{Method, Trial};
+use super::integrator::{Method, RungeKutta, Trial};
 use super::phase::Phase;
 use super::thresholds::{ROOT_ITERATIONS, SHORTEST_AIM_ULPS, SIMULTANEOUS_ULPS};
 use super::{SimError, Simulator};
@@ -34,8 +34,8 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     /// the wall at the end of one step, with no step across it to redo; for
     /// other motions the prediction only shortens a step, and the crossing
     /// is found on the step as usual.
-    pub(super) fn aim(&self, y0: &Phase<N>) -> Option<Aim> {
-        if !self.settings.integrator.adaptive() {
+    pub(super) fn aim(&self, method: &RungeKutta, y0: &Phase<N>) -> Option<Aim> {
+        if !method.adaptive() {
             return None;
         }
         let m = self.model;

@@ -57,3 +57,11 @@ pub const ROOT_ITERATIONS: usize = 200;
 /// whatever the step (see [`super::Settings::simultaneous`]): equal instants
 /// computed by different roundings differ by about this much.
 pub const SIMULTANEOUS_ULPS: f64 = 4.0;
+
+/// Points at which Taylor's method samples each wall's f on the step's
+/// polynomial for a sign change (or a turn towards the wall) before the
+/// root is found by Newton's method on that polynomial.
+pub const SERIES_SAMPLES: usize = 16;
+
+/// Newton (or bisection) steps at most on the step's polynomial.
+pub const SERIES_ROOT_ITERATIONS: usize = 100;

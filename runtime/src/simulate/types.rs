@@ -172,6 +172,9 @@ pub enum SimError<W> {
     },
     /// A setting is out of range (a non-positive step or tolerance).
     BadSettings,
+    /// Taylor's method was asked for, but the model has no Taylor series
+    /// (its q̈ is not in closed form, or a wall has no series of f).
+    NoSeries,
     /// The model has more walls than the simulator tracks
     /// ([`super::thresholds::MAX_WALLS`]).
     TooManyWalls {
@@ -228,6 +231,10 @@ impl<W: core::fmt::Debug> core::fmt::Display for SimError<W> {
                 write!(f, "at t = {t}: the step size fell to {step:e}")
             }
             SimError::BadSettings => write!(f, "a step or tolerance is not positive and finite"),
+            SimError::NoSeries => write!(
+                f,
+                "Taylor's method needs the model's Taylor series, which it has only where q̈ is in closed form"
+            ),
             SimError::TooManyWalls { walls } => write!(
                 f,
                 "the model has {walls} walls; the simulator handles at most {}",

@@ -1,17 +1,23 @@
-//! Integration methods between collisions. Each is one file with its
-//! tableau, its dense output and its step-size control, and implements
-//! [`Method`]; [`Integrator`] names them in [`super::Settings`].
+//! Integration methods between collisions. Each is one file. The
+//! Runge–Kutta methods have their tableau, dense output and step-size
+//! control and implement [`Method`] over evaluations of (q̇, q̈); Taylor's
+//! method steps along the model's own series (`taylor.rs`, and the
+//! simulator's `series.rs` for its events). [`Integrator`] names them in
+//! [`super::Settings`].
 //!
-//! Adding a method: a file here implementing [`Method`], a variant of
-//! [`Integrator`], and its arm in `with_method!`.
+//! Adding a Runge–Kutta method: a file here implementing [`Method`], a
+//! variant of [`Integrator`] and of [`RungeKutta`], and its arm in
+//! `with_method!`.
 
 mod dense;
 mod dopri;
 mod rk4;
+mod taylor;
 
 pub(crate) use dense::Dense;
 pub use dopri::DormandPrince;
 pub use rk4::Rk4;
+pub use taylor::Taylor;
 
 use super::phase::Phase;
 
@@ -21,6 +27,42 @@ pub enum Integrator {
     /// Classical fourth-order Runge–Kutta with a fixed step.
     Rk4(Rk4),
     /// Dormand–Prince 5(4) with error control.
+    DormandPrince(DormandPrince),
+    /// Taylor's method on the model's generated series, with events found
+    /// on the step's polynomial (models whose q̈ is in closed form).
+    Taylor(Taylor),
+}
+
+/// How the simulator steps: by evaluations of (q̇, q̈), or along series.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Engine {
+    RungeKutta(RungeKutta),
+    Taylor(Taylor),
+}
+
+impl Integrator {
+    /// Whether the settings are usable (positive, finite steps and
+    /// tolerances).
+    pub fn valid(&self) -> bool {
+        match self.engine() {
+            Engine::RungeKutta(m) => m.valid(),
+            Engine::Taylor(t) => t.valid(),
+        }
+    }
+
+    pub(crate) fn engine(&self) -> Engine {
+        match *self {
+            Integrator::Rk4(m) => Engine::RungeKutta(RungeKutta::Rk4(m)),
+            Integrator::DormandPrince(m) => Engine::RungeKutta(RungeKutta::DormandPrince(m)),
+            Integrator::Taylor(t) => Engine::Taylor(t),
+        }
+    }
+}
+
+/// The methods that step by evaluations of (q̇, q̈).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum RungeKutta {
+    Rk4(Rk4),
     DormandPrince(DormandPrince),
 }
 
@@ -83,13 +125,13 @@ pub(crate) trait Method {
 macro_rules! with_method {
     ($integrator:expr, $m:ident => $body:expr) => {
         match $integrator {
-            Integrator::Rk4($m) => $body,
-            Integrator::DormandPrince($m) => $body,
+            RungeKutta::Rk4($m) => $body,
+            RungeKutta::DormandPrince($m) => $body,
         }
     };
 }
 
-impl Method for Integrator {
+impl Method for RungeKutta {
     fn valid(&self) -> bool {
         with_method!(self, m => m.valid())
     }

@@ -1,0 +1,231 @@
+//! The Taylor-mode functions of a model whose q̈ is in closed form: the
+//! series of the motion (`motion_series`) and, per wall, of f along it
+//! (`{wall}_surface_series`), each the Taylor transform
+//! ([`crate::program::Transform`]) of a program the table already holds,
+//! written out as one loop over the orders with one statement per
+//! recurrence. f64 only (the runtime's series are f64).
+
+use proc_macro2::{Literal, TokenStream};
+use quote::{format_ident, quote};
+
+use super::Ctx;
+use super::body::{self, Place};
+use crate::program::{Emit, Op, Program, Series, Slot, Term, Transform};
+use crate::quantity::Quantity;
+
+/// The model's transforms: q̈'s, then each wall's f's (`None` where q̈ has
+/// no closed form: then the model has no series at all).
+pub(super) fn transforms(d: &Ctx) -> Option<(Transform, Vec<Transform>)> {
+    if d.scalar != super::Scalar::F64 {
+        return None;
+    }
+    let (np, nq) = (d.model.params.len(), d.model.coordinates.len());
+    let motion = d.function(Quantity::Accelerations)?.program.taylor(np, nq);
+    let walls = d
+        .walls
+        .iter()
+        .map(|w| {
+            w.function(Quantity::Surface)
+                .map(|f| f.program.taylor(np, nq))
+        })
+        .collect::<Option<Vec<_>>>()?;
+    Some((motion, walls))
+}
+
+/// Series operations per order, and how many of them are convolutions (a
+/// loop over the coefficients so far): for the header.
+pub(super) fn counts(t: &Transform) -> (usize, usize) {
+    let loops = t
+        .ops
+        .iter()
+        .filter(|op| !matches!(op, Op::Add { .. } | Op::Scale { .. }))
+        .count();
+    (t.ops.len(), loops)
+}
+
+/// `motion_series` and every `{wall}_surface_series`.
+pub(super) fn functions(d: &Ctx) -> TokenStream {
+    let Some((motion, walls)) = transforms(d) else {
+        return TokenStream::new();
+    };
+    let n = Literal::usize_unsuffixed(d.model.velocities.len());
+    let motion_prelude = prelude(d, &motion);
+    let motion_ops = ops(d, &motion);
+    let feedback = (0..d.model.velocities.len()).map(|i| {
+        let i_lit = Literal::usize_unsuffixed(i);
+        let out = output(d, &motion, i);
+        quote! {
+            s.q[#i_lit][k + 1] = s.v[#i_lit][k] / kf;
+            s.v[#i_lit][k + 1] = #out / kf;
+        }
+    });
+    let motion_fn = quote! {
+        /// The Taylor series of the motion through the state at order 0 of
+        /// `s` (q(t₀), q̇(t₀)): fills its orders 1 to `order` (at most
+        /// `taylor::MAX_ORDER`) by the Taylor transform of `accelerations`,
+        /// one order at a time.
+        #[allow(unused_variables, clippy::approx_constant, clippy::needless_range_loop)]
+        pub fn motion_series(&self, s: &mut ::dalembert_runtime::taylor::Series<#n>, order: usize) {
+            let order = order.min(::dalembert_runtime::taylor::MAX_ORDER);
+            #motion_prelude
+            for k in 0..order {
+                #motion_ops
+                let kf = (k + 1) as f64;
+                #(#feedback)*
+            }
+            s.order = order;
+        }
+    };
+    let wall_fns = d.walls.iter().zip(&walls).map(|(w, t)| {
+        let name = format_ident!("{}_surface_series", w.name);
+        let doc = format!(
+            " Wall `{}`: the Taylor coefficients of f(q(t)) along `s`, orders 0 to `s.order`.",
+            w.name
+        );
+        let prelude = prelude(d, t);
+        let ops = ops(d, t);
+        let out = output(d, t, 0);
+        quote! {
+            #[doc = #doc]
+            #[allow(unused_variables, clippy::approx_constant, clippy::needless_range_loop)]
+            pub fn #name(
+                &self,
+                s: &::dalembert_runtime::taylor::Series<#n>,
+                out: &mut ::dalembert_runtime::taylor::Coefficients,
+            ) {
+                #prelude
+                for k in 0..=s.order.min(::dalembert_runtime::taylor::MAX_ORDER) {
+                    #ops
+                    out[k] = #out;
+                }
+            }
+        }
+    });
+    quote! { #motion_fn #(#wall_fns)* }
+}
+
+/// The time-constant values and the zeroed intermediate series.
+fn prelude(d: &Ctx, t: &Transform) -> TokenStream {
+    let plan = vec![Emit::Compute; t.numbers.instrs.len()];
+    let numbers = body::statements(d, &t.numbers, &plan, Place::Call);
+    // Series operations read parameters directly too (a product with m);
+    // those the numbers read are bound by their statements.
+    let read: Vec<Slot> = t
+        .numbers
+        .instrs
+        .iter()
+        .flat_map(|ins| ins.sources().to_vec())
+        .collect();
+    let params = d
+        .model
+        .params
+        .iter()
+        .enumerate()
+        .filter(move |(i, _)| !read.contains(&Slot::Input(*i)))
+        .map(|(i, p)| {
+            let (name, field) = (format_ident!("i{i}"), super::ident(&p.name));
+            quote! { let #name: f64 = self.params.#field; }
+        });
+    let temps = (0..t.temps).map(|j| {
+        let x = format_ident!("x{j}");
+        quote! { let mut #x: ::dalembert_runtime::taylor::Coefficients = [0.0; ::dalembert_runtime::taylor::CAPACITY]; }
+    });
+    quote! { #(#params)* #numbers #(#temps)* }
+}
+
+/// A series as an expression (`s.q[i]`, `s.v[i]`, `x{j}`).
+fn series(s: Series) -> TokenStream {
+    match s {
+        Series::Q(i) => {
+            let i = Literal::usize_unsuffixed(i);
+            quote! { s.q[#i] }
+        }
+        Series::V(i) => {
+            let i = Literal::usize_unsuffixed(i);
+            quote! { s.v[#i] }
+        }
+        Series::Temp(j) => {
+            let x = format_ident!("x{j}");
+            quote! { #x }
+        }
+    }
+}
+
+fn number(d: &Ctx, p: &Program, s: Slot) -> TokenStream {
+    body::slot(d, p, s)
+}
+
+/// Coefficient k of output `o`.
+fn output(d: &Ctx, t: &Transform, o: usize) -> TokenStream {
+    match t.outputs[o] {
+        Term::Number(Slot::Const(i)) if t.numbers.consts[i] == 0.0 => quote! { 0.0 },
+        Term::Number(s) => {
+            let x = number(d, &t.numbers, s);
+            quote! { (if k == 0 { #x } else { 0.0 }) }
+        }
+        Term::Series(s) => {
+            let s = series(s);
+            quote! { #s[k] }
+        }
+    }
+}
+
+/// Order k of every op.
+fn ops(d: &Ctx, t: &Transform) -> TokenStream {
+    let tay = quote! { ::dalembert_runtime::taylor };
+    let p = &t.numbers;
+    let stmts = t.ops.iter().map(|op| match op {
+        Op::Add {
+            dst,
+            series: terms,
+            numbers,
+        } => {
+            let dst = series(*dst);
+            let terms = terms.iter().map(|s| {
+                let s = series(*s);
+                quote! { #s[k] }
+            });
+            let constant = (!numbers.is_empty()).then(|| {
+                let ns = numbers.iter().map(|s| number(d, p, *s));
+                quote! { if k == 0 { #dst[0] += #(#ns)+*; } }
+            });
+            quote! { #dst[k] = #(#terms)+*; #constant }
+        }
+        Op::Scale { dst, a, by } => {
+            let (dst, a) = (series(*dst), series(*a));
+            if matches!(by, Slot::Const(i) if p.consts[*i] == -1.0) {
+                quote! { #dst[k] = -#a[k]; }
+            } else {
+                let by = number(d, p, *by);
+                quote! { #dst[k] = #a[k] * #by; }
+            }
+        }
+        Op::Mul { dst, a, b } => {
+            let (dst, a, b) = (series(*dst), series(*a), series(*b));
+            quote! { #dst[k] = #tay::mul(&#a, &#b, k); }
+        }
+        Op::Square { dst, a } => {
+            let (dst, a) = (series(*dst), series(*a));
+            quote! { #dst[k] = #tay::square(&#a, k); }
+        }
+        Op::Recip { dst, a } => unary(quote! { #tay::recip }, *dst, *a, None),
+        Op::Sqrt { dst, a } => unary(quote! { #tay::sqrt }, *dst, *a, None),
+        Op::Exp { dst, a } => unary(quote! { #tay::exp }, *dst, *a, None),
+        Op::Log { dst, a } => unary(quote! { #tay::log }, *dst, *a, None),
+        Op::Power { dst, a, alpha } => {
+            let alpha = Literal::f64_suffixed(*alpha);
+            unary(quote! { #tay::power }, *dst, *a, Some(quote! { #alpha, }))
+        }
+        Op::SinCos { sin, cos, a } => {
+            let (s, c, a) = (series(*sin), series(*cos), series(*a));
+            quote! { (#s[k], #c[k]) = #tay::sin_cos(&#s, &#c, &#a, k); }
+        }
+    });
+    quote! { #(#stmts)* }
+}
+
+/// dst[k] = f(&dst, &a, [extra,] k): a recurrence on its own result.
+fn unary(f: TokenStream, dst: Series, a: Series, extra: Option<TokenStream>) -> TokenStream {
+    let (dst, a) = (series(dst), series(a));
+    quote! { #dst[k] = #f(&#dst, &#a, #extra k); }
+}

@@ -1,0 +1,584 @@
+//! The Taylor transform of a straight-line program: the same computation on
+//! truncated power series in time, one order at a time.
+//!
+//! Coordinates and velocities are series (their coefficients filled in by
+//! the integrator, or by the motion itself for q̈); parameters, constants
+//! and whatever depends on them alone stay numbers, computed once per call
+//! as a small program of their own. Every instruction that reads a series
+//! becomes one or more [`Op`]s, each the recurrence for one coefficient of
+//! its result (`dalembert_runtime::taylor`): a product with a number is a
+//! scaling, a product of series a convolution, a power xⁿ (n ≤ 8)
+//! repeated products and, for n < 0, a reciprocal, sin and cos of one
+//! series one pair. Slots that the program writes again get a fresh series
+//! each time, so every coefficient can be kept.
+
+use std::collections::HashMap;
+
+use dalembert_runtime::taylor::{self as tay, Coefficients};
+
+use super::{Func, Instr, Program, Slot, constant};
+
+/// A series the transform reads or writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Series {
+    /// Coordinate i.
+    Q(usize),
+    /// Velocity i.
+    V(usize),
+    /// An intermediate value, numbered from 0.
+    Temp(usize),
+}
+
+/// A value of the transform: a number (a slot of [`Transform::numbers`]:
+/// a parameter input, a constant or a temporary there) or a series.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Term {
+    /// Constant in time.
+    Number(Slot),
+    /// A series.
+    Series(Series),
+}
+
+/// One coefficient of one intermediate series from coefficients of others
+/// (`dst` is always a [`Series::Temp`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Op {
+    /// Σ series + Σ numbers (the numbers count at order 0 only).
+    Add {
+        dst: Series,
+        series: Vec<Series>,
+        numbers: Vec<Slot>,
+    },
+    /// a times a number.
+    Scale { dst: Series, a: Series, by: Slot },
+    /// a·b.
+    Mul { dst: Series, a: Series, b: Series },
+    /// a².
+    Square { dst: Series, a: Series },
+    /// 1/a.
+    Recip { dst: Series, a: Series },
+    /// √a.
+    Sqrt { dst: Series, a: Series },
+    /// a^α for a real α.
+    Power { dst: Series, a: Series, alpha: f64 },
+    /// exp(a).
+    Exp { dst: Series, a: Series },
+    /// ln(a).
+    Log { dst: Series, a: Series },
+    /// sin(a) and cos(a) together.
+    SinCos { sin: Series, cos: Series, a: Series },
+}
+
+/// A program's Taylor transform.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Transform {
+    /// The time-constant values: a program over the original inputs
+    /// (parameters only are read) and constants, writing temporaries and
+    /// no outputs.
+    pub numbers: Program,
+    /// Intermediate series in use.
+    pub temps: usize,
+    /// The series operations, in order: run them all for order k, then for
+    /// k + 1.
+    pub ops: Vec<Op>,
+    /// Each output of the program.
+    pub outputs: Vec<Term>,
+}
+
+impl Program {
+    /// The Taylor transform when the inputs are `params` parameters, then
+    /// `coords` coordinates, then velocities.
+    pub fn taylor(&self, params: usize, coords: usize) -> Transform {
+        Builder::new(self, params, coords).run()
+    }
+}
+
+struct Builder<'a> {
+    p: &'a Program,
+    numbers: Program,
+    ops: Vec<Op>,
+    temps: usize,
+    numbers_written: usize,
+    bound: HashMap<Slot, Term>,
+    /// sin and cos already taken of a series.
+    trig: HashMap<Series, (Series, Series)>,
+    params: usize,
+    coords: usize,
+}
+
+impl<'a> Builder<'a> {
+    fn new(p: &'a Program, params: usize, coords: usize) -> Self {
+        Self {
+            p,
+            numbers: Program {
+                inputs: p.inputs,
+                consts: p.consts.clone(),
+                instrs: Vec::new(),
+                outputs: 0,
+            },
+            ops: Vec::new(),
+            temps: 0,
+            numbers_written: 0,
+            bound: HashMap::new(),
+            trig: HashMap::new(),
+            params,
+            coords,
+        }
+    }
+
+    fn run(mut self) -> Transform {
+        for ins in &self.p.instrs {
+            let value = self.instr(ins);
+            self.bound.insert(ins.dst(), value);
+        }
+        let outputs = (0..self.p.outputs)
+            .map(|k| {
+                self.bound
+                    .get(&Slot::Out(k))
+                    .copied()
+                    .unwrap_or_else(|| Term::Number(constant(&mut self.numbers.consts, 0.0)))
+            })
+            .collect();
+        Transform {
+            numbers: self.numbers,
+            temps: self.temps,
+            ops: self.ops,
+            outputs,
+        }
+    }
+
+    fn term(&self, s: Slot) -> Term {
+        match s {
+            Slot::Input(i) if i < self.params => Term::Number(s),
+            Slot::Input(i) if i < self.params + self.coords => {
+                Term::Series(Series::Q(i - self.params))
+            }
+            Slot::Input(i) => Term::Series(Series::V(i - self.params - self.coords)),
+            Slot::Const(_) => Term::Number(s),
+            Slot::Temp(_) | Slot::Out(_) => self.bound[&s],
+        }
+    }
+
+    fn temp(&mut self) -> Series {
+        self.temps += 1;
+        Series::Temp(self.temps - 1)
+    }
+
+    /// A number computed by `make(dst)`.
+    fn number(&mut self, make: impl FnOnce(Slot) -> Instr) -> Term {
+        let dst = Slot::Temp(self.numbers_written);
+        self.numbers_written += 1;
+        self.numbers.instrs.push(make(dst));
+        Term::Number(dst)
+    }
+
+    fn op(&mut self, make: impl FnOnce(Series) -> Op) -> Series {
+        let dst = self.temp();
+        self.ops.push(make(dst));
+        dst
+    }
+
+    fn instr(&mut self, ins: &Instr) -> Term {
+        let terms: Vec<Term> = ins.sources().iter().map(|&s| self.term(s)).collect();
+        let numbers: Option<Vec<Slot>> = terms
+            .iter()
+            .map(|t| match t {
+                Term::Number(s) => Some(*s),
+                Term::Series(_) => None,
+            })
+            .collect();
+        if let Some(slots) = numbers {
+            // Constant in time: the instruction itself, on numbers.
+            return match ins {
+                Instr::Assign(_, _) => Term::Number(slots[0]),
+                _ => self.number(|dst| with_sources(ins, dst, &slots)),
+            };
+        }
+        let series_of = |t: &Term| match t {
+            Term::Series(s) => *s,
+            Term::Number(_) => unreachable!("checked to be a series"),
+        };
+        match ins {
+            Instr::Assign(_, _) => terms[0],
+            Instr::Add(_, _) => {
+                let mut series = Vec::new();
+                let mut numbers = Vec::new();
+                for t in &terms {
+                    match t {
+                        Term::Series(s) => series.push(*s),
+                        Term::Number(n) => numbers.push(*n),
+                    }
+                }
+                Term::Series(self.op(|dst| Op::Add {
+                    dst,
+                    series,
+                    numbers,
+                }))
+            }
+            Instr::Mul(_, _) => {
+                let mut acc = terms[0];
+                for t in &terms[1..] {
+                    acc = self.times(acc, *t);
+                }
+                acc
+            }
+            Instr::Pow(_, _, n) => {
+                let a = series_of(&terms[0]);
+                let m = n.unsigned_abs();
+                let positive = if m == 0 {
+                    return Term::Number(constant(&mut self.numbers.consts, 1.0));
+                } else if m <= 8 {
+                    let mut acc = Term::Series(a);
+                    for _ in 1..m {
+                        acc = self.times(acc, Term::Series(a));
+                    }
+                    series_of(&acc)
+                } else {
+                    return Term::Series(self.op(|dst| Op::Power {
+                        dst,
+                        a,
+                        alpha: *n as f64,
+                    }));
+                };
+                if *n < 0 {
+                    Term::Series(self.op(|dst| Op::Recip { dst, a: positive }))
+                } else {
+                    Term::Series(positive)
+                }
+            }
+            Instr::Powf(_, _, e) => {
+                let a = series_of(&terms[0]);
+                if *e == 0.5 || *e == -0.5 {
+                    let root = self.op(|dst| Op::Sqrt { dst, a });
+                    if *e < 0.0 {
+                        Term::Series(self.op(|dst| Op::Recip { dst, a: root }))
+                    } else {
+                        Term::Series(root)
+                    }
+                } else {
+                    Term::Series(self.op(|dst| Op::Power { dst, a, alpha: *e }))
+                }
+            }
+            Instr::Fun(_, f, _) => {
+                let a = series_of(&terms[0]);
+                Term::Series(match f {
+                    Func::Sin | Func::Cos => {
+                        let (s, c) = match self.trig.get(&a) {
+                            Some(pair) => *pair,
+                            None => {
+                                let (sin, cos) = (self.temp(), self.temp());
+                                self.ops.push(Op::SinCos { sin, cos, a });
+                                self.trig.insert(a, (sin, cos));
+                                (sin, cos)
+                            }
+                        };
+                        if *f == Func::Sin { s } else { c }
+                    }
+                    Func::Exp => self.op(|dst| Op::Exp { dst, a }),
+                    Func::Log => self.op(|dst| Op::Log { dst, a }),
+                    Func::Sqrt => self.op(|dst| Op::Sqrt { dst, a }),
+                })
+            }
+        }
+    }
+
+    /// a·b, where at least one is a series or both are numbers.
+    fn times(&mut self, a: Term, b: Term) -> Term {
+        match (a, b) {
+            (Term::Number(x), Term::Number(y)) => self.number(|dst| Instr::Mul(dst, vec![x, y])),
+            (Term::Series(s), Term::Number(n)) | (Term::Number(n), Term::Series(s)) => {
+                Term::Series(self.op(|dst| Op::Scale { dst, a: s, by: n }))
+            }
+            (Term::Series(x), Term::Series(y)) if x == y => {
+                Term::Series(self.op(|dst| Op::Square { dst, a: x }))
+            }
+            (Term::Series(x), Term::Series(y)) => {
+                Term::Series(self.op(|dst| Op::Mul { dst, a: x, b: y }))
+            }
+        }
+    }
+}
+
+/// `ins` writing `dst` from `sources` (its own, renamed).
+fn with_sources(ins: &Instr, dst: Slot, sources: &[Slot]) -> Instr {
+    match ins {
+        Instr::Add(..) => Instr::Add(dst, sources.to_vec()),
+        Instr::Mul(..) => Instr::Mul(dst, sources.to_vec()),
+        Instr::Pow(_, _, n) => Instr::Pow(dst, sources[0], *n),
+        Instr::Powf(_, _, x) => Instr::Powf(dst, sources[0], *x),
+        Instr::Fun(_, f, _) => Instr::Fun(dst, *f, sources[0]),
+        Instr::Assign(..) => Instr::Assign(dst, sources[0]),
+    }
+}
+
+impl Op {
+    /// What it writes (both halves for a sin/cos pair).
+    pub fn writes(&self) -> Vec<Series> {
+        match self {
+            Op::SinCos { sin, cos, .. } => vec![*sin, *cos],
+            Op::Add { dst, .. }
+            | Op::Scale { dst, .. }
+            | Op::Mul { dst, .. }
+            | Op::Square { dst, .. }
+            | Op::Recip { dst, .. }
+            | Op::Sqrt { dst, .. }
+            | Op::Power { dst, .. }
+            | Op::Exp { dst, .. }
+            | Op::Log { dst, .. } => vec![*dst],
+        }
+    }
+}
+
+/// The series state of an evaluation: coordinates, velocities, temporaries.
+#[derive(Clone, Debug)]
+pub struct Evaluation {
+    /// Coefficients of each coordinate.
+    pub q: Vec<Coefficients>,
+    /// Coefficients of each velocity.
+    pub v: Vec<Coefficients>,
+    /// Coefficients of each intermediate series.
+    pub temps: Vec<Coefficients>,
+}
+
+impl Transform {
+    /// The time-constant values at the parameters `params`: a vector that
+    /// [`Term::Number`] slots index by [`Transform::number_index`].
+    pub fn number_values(&self, params: &[f64]) -> Vec<f64> {
+        let mut inputs = vec![0.0; self.numbers.inputs];
+        inputs[..params.len()].copy_from_slice(params);
+        let mut p = self.numbers.clone();
+        // The temporaries as outputs, to read them back.
+        let written = p
+            .instrs
+            .iter()
+            .filter_map(|i| match i.dst() {
+                Slot::Temp(k) => Some(k + 1),
+                _ => None,
+            })
+            .max()
+            .unwrap_or(0);
+        p.instrs
+            .extend((0..written).map(|k| Instr::Assign(Slot::Out(k), Slot::Temp(k))));
+        p.outputs = written;
+        let temps = p.eval(&inputs);
+        let mut all = inputs;
+        all.extend(&self.numbers.consts);
+        all.extend(temps);
+        all
+    }
+
+    /// Where a number slot's value is in [`Transform::number_values`].
+    pub fn number_index(&self, s: Slot) -> usize {
+        match s {
+            Slot::Input(i) => i,
+            Slot::Const(i) => self.numbers.inputs + i,
+            Slot::Temp(i) | Slot::Out(i) => self.numbers.inputs + self.numbers.consts.len() + i,
+        }
+    }
+
+    /// Runs order k of every op on `e` (coefficients below k in place).
+    pub fn order(&self, e: &mut Evaluation, numbers: &[f64], k: usize) {
+        for op in &self.ops {
+            let get = |s: Series| match s {
+                Series::Q(i) => e.q[i],
+                Series::V(i) => e.v[i],
+                Series::Temp(i) => e.temps[i],
+            };
+            let slot_value = |s: &Slot| numbers[self.number_index(*s)];
+            let value = match op {
+                Op::SinCos { sin, cos, a } => {
+                    let (s, c) = tay::sin_cos(&get(*sin), &get(*cos), &get(*a), k);
+                    let (Series::Temp(si), Series::Temp(ci)) = (sin, cos) else {
+                        unreachable!("pairs write temporaries")
+                    };
+                    e.temps[*si][k] = s;
+                    e.temps[*ci][k] = c;
+                    continue;
+                }
+                Op::Add {
+                    series, numbers, ..
+                } => {
+                    let mut x: f64 = series.iter().map(|s| get(*s)[k]).sum();
+                    if k == 0 {
+                        x += numbers.iter().map(slot_value).sum::<f64>();
+                    }
+                    x
+                }
+                Op::Scale { a, by, .. } => get(*a)[k] * slot_value(by),
+                Op::Mul { a, b, .. } => tay::mul(&get(*a), &get(*b), k),
+                Op::Square { a, .. } => tay::square(&get(*a), k),
+                Op::Recip { dst, a } => tay::recip(&get(*dst), &get(*a), k),
+                Op::Sqrt { dst, a } => tay::sqrt(&get(*dst), &get(*a), k),
+                Op::Power { dst, a, alpha } => tay::power(&get(*dst), &get(*a), *alpha, k),
+                Op::Exp { dst, a } => tay::exp(&get(*dst), &get(*a), k),
+                Op::Log { dst, a } => tay::log(&get(*dst), &get(*a), k),
+            };
+            let Series::Temp(d) = op.writes()[0] else {
+                unreachable!("ops write temporaries")
+            };
+            e.temps[d][k] = value;
+        }
+    }
+
+    /// Coefficient k of output `o`.
+    pub fn output(&self, e: &Evaluation, numbers: &[f64], o: usize, k: usize) -> f64 {
+        match self.outputs[o] {
+            Term::Number(s) if k == 0 => numbers[self.number_index(s)],
+            Term::Number(_) => 0.0,
+            Term::Series(Series::Q(i)) => e.q[i][k],
+            Term::Series(Series::V(i)) => e.v[i][k],
+            Term::Series(Series::Temp(i)) => e.temps[i][k],
+        }
+    }
+
+    /// The Taylor series of the motion q̈ = this program's outputs through
+    /// (q, v), to `order` (for tests and the interpreter; emitted code does
+    /// the same in straight-line Rust).
+    pub fn motion(&self, params: &[f64], q: &[f64], v: &[f64], order: usize) -> Evaluation {
+        let numbers = self.number_values(params);
+        let mut e = Evaluation {
+            q: vec![[0.0; tay::CAPACITY]; q.len()],
+            v: vec![[0.0; tay::CAPACITY]; v.len()],
+            temps: vec![[0.0; tay::CAPACITY]; self.temps],
+        };
+        for i in 0..q.len() {
+            e.q[i][0] = q[i];
+        }
+        for i in 0..v.len() {
+            e.v[i][0] = v[i];
+        }
+        let order = order.min(tay::MAX_ORDER);
+        for k in 0..order {
+            self.order(&mut e, &numbers, k);
+            let kf = (k + 1) as f64;
+            for i in 0..v.len() {
+                e.q[i][k + 1] = e.v[i][k] / kf;
+                e.v[i][k + 1] = self.output(&e, &numbers, i, k) / kf;
+            }
+        }
+        e
+    }
+
+    /// The coefficients of the first output along the coordinates' series
+    /// in `e` (its temporaries overwritten), orders 0 to `order`.
+    pub fn along(&self, params: &[f64], e: &mut Evaluation, order: usize) -> Coefficients {
+        let numbers = self.number_values(params);
+        e.temps = vec![[0.0; tay::CAPACITY]; self.temps];
+        let mut out = [0.0; tay::CAPACITY];
+        for (k, o) in out
+            .iter_mut()
+            .enumerate()
+            .take(order.min(tay::MAX_ORDER) + 1)
+        {
+            self.order(e, &numbers, k);
+            *o = self.output(e, &numbers, 0, k);
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// q̈ = −(g/l)·sin q (the pendulum): the transform's series of q is
+    /// the solution's, checked against a tiny-step integration of the
+    /// same equation through the Taylor polynomial's derivatives at 0
+    /// (q₂ = −(g/l) sin q₀ / 2, q₃ = −(g/l) cos q₀ q₁ / 6, …) and by the
+    /// energy staying constant along the polynomial.
+    #[test]
+    fn pendulum_series() {
+        // inputs: g, l, q, v; q̈ = -(g * l^-1) * sin(q)
+        let (g, l, q, v) = (
+            Slot::Input(0),
+            Slot::Input(1),
+            Slot::Input(2),
+            Slot::Input(3),
+        );
+        let _ = v;
+        let p = Program {
+            inputs: 4,
+            consts: vec![-1.0],
+            instrs: vec![
+                Instr::Pow(Slot::Temp(0), l, -1),
+                Instr::Fun(Slot::Temp(1), Func::Sin, q),
+                Instr::Mul(
+                    Slot::Out(0),
+                    vec![Slot::Const(0), g, Slot::Temp(0), Slot::Temp(1)],
+                ),
+            ],
+            outputs: 1,
+        };
+        let t = p.taylor(2, 1);
+        // Only the product with sin q is series work.
+        assert_eq!(t.ops.len(), 2, "{:?}", t.ops);
+        let (gv, lv, q0, v0) = (9.81, 2.0, 0.7, -0.4);
+        let e = t.motion(&[gv, lv], &[q0], &[v0], 20);
+        let w = gv / lv;
+        assert_eq!(e.q[0][1], v0);
+        assert!((e.q[0][2] - (-w * q0.sin() / 2.0)).abs() < 1e-16);
+        assert!((e.q[0][3] - (-w * q0.cos() * v0 / 6.0)).abs() < 1e-16);
+        // Energy ½v² − w cos q along the polynomial, at τ up to 0.2.
+        let energy = |tau: f64| {
+            let qq = tay::eval(&e.q[0], 20, tau);
+            let vv = tay::eval(&e.v[0], 20, tau);
+            0.5 * vv * vv - w * qq.cos()
+        };
+        for j in 1..=10 {
+            let tau = 0.02 * j as f64;
+            assert!((energy(tau) - energy(0.0)).abs() < 1e-14, "{tau}");
+        }
+    }
+
+    /// Every kind of instruction: the transform of
+    /// o = exp(x)·log(x)·x^-2 + sqrt(x) + x^1.5 + x^10 + 1/sqrt(x) + cos(x)
+    /// along x(t) = 2 + t agrees with its values at a few points of t.
+    #[test]
+    fn every_instruction_along_a_line() {
+        let x = Slot::Input(1);
+        let t = |k| Slot::Temp(k);
+        let p = Program {
+            inputs: 2,
+            consts: vec![],
+            instrs: vec![
+                Instr::Fun(t(0), Func::Exp, x),
+                Instr::Fun(t(1), Func::Log, x),
+                Instr::Pow(t(2), x, -2),
+                Instr::Mul(t(3), vec![t(0), t(1), t(2)]),
+                Instr::Fun(t(4), Func::Sqrt, x),
+                Instr::Powf(t(5), x, 1.5),
+                Instr::Pow(t(6), x, 10),
+                Instr::Powf(t(7), x, -0.5),
+                Instr::Fun(t(8), Func::Cos, x),
+                Instr::Add(Slot::Out(0), vec![t(3), t(4), t(5), t(6), t(7), t(8)]),
+            ],
+            outputs: 1,
+        };
+        let f = |x: f64| {
+            x.exp() * x.ln() / (x * x)
+                + x.sqrt()
+                + x.powf(1.5)
+                + x.powi(10)
+                + 1.0 / x.sqrt()
+                + x.cos()
+        };
+        // inputs: one parameter (unused), then the coordinate x.
+        let tr = p.taylor(1, 1);
+        let mut e = Evaluation {
+            q: vec![[0.0; tay::CAPACITY]],
+            v: vec![],
+            temps: vec![],
+        };
+        e.q[0][0] = 2.0;
+        e.q[0][1] = 1.0;
+        let c = tr.along(&[0.0], &mut e, 30);
+        for tau in [0.0, 0.1, -0.2, 0.3] {
+            let got = tay::eval(&c, 30, tau);
+            let want = f(2.0 + tau);
+            assert!(
+                (got - want).abs() <= 1e-12 * want.abs(),
+                "{tau}: {got} {want}"
+            );
+        }
+    }
+}

@@ -1,0 +1,291 @@
+//! Steps of Taylor's method: the series of the motion from the state, the
+//! step from its last coefficients, each wall's f along the step as a
+//! polynomial, and the first collision found on that polynomial to
+//! rounding (samples for a sign change or a turn towards the wall, then
+//! Newton's method kept inside the bracket). The state at the collision is
+//! the step's polynomial there, so a collision costs no further steps.
+
+use super::integrator::Taylor;
+use super::phase::Phase;
+use super::thresholds::{SERIES_ROOT_ITERATIONS, SERIES_SAMPLES};
+use super::{SimError, Simulator, State, Step};
+use crate::Surfaces;
+use crate::dynamics::DynamicsError;
+use crate::taylor::{CAPACITY, Coefficients, Series, eval, eval_with_derivative};
+
+/// Whether `m` has the series Taylor's method needs (of the motion and of
+/// every wall's f).
+pub(super) fn offered<M: Surfaces<N>, const N: usize>(
+    m: &M,
+    start: &State<N>,
+) -> Result<(), SimError<M::Wall>> {
+    let mut s = Series::at(&start.q, &start.v);
+    if !m.taylor_series(&mut s, 1) {
+        return Err(SimError::NoSeries);
+    }
+    let mut f = [0.0; CAPACITY];
+    for &wall in m.walls() {
+        if !m.surface_series(wall, &s, &mut f) {
+            return Err(SimError::NoSeries);
+        }
+    }
+    Ok(())
+}
+
+impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
+    /// [`Simulator::step`] by Taylor's method.
+    pub(super) fn series_step(
+        &mut self,
+        method: &Taylor,
+        t_end: f64,
+    ) -> Result<Step<M::Wall, N>, SimError<M::Wall>> {
+        let t0 = self.state.t;
+        let m = self.model;
+        let mut s = Series::at(&self.state.q, &self.state.v);
+        if !m.taylor_series(&mut s, method.order()) {
+            return Err(SimError::NoSeries);
+        }
+        self.stats.evaluations += 1;
+        let finite = |c: &Coefficients| c[..=s.order].iter().all(|x| x.is_finite());
+        if !s.q.iter().chain(&s.v).all(finite) {
+            return Err(SimError::Dynamics {
+                t: t0,
+                error: DynamicsError::NonFinite,
+            });
+        }
+        let left = (t_end - t0) - self.t_low;
+        let h = method.step(&s).min(left);
+        if !(h > 0.0) {
+            return Err(SimError::StepTooSmall { t: t0, step: h });
+        }
+        let mut best: Option<(usize, f64)> = None;
+        let mut second: Option<f64> = None;
+        let mut f = [0.0; CAPACITY];
+        for (k, &wall) in m.walls().iter().enumerate() {
+            m.surface_series(wall, &s, &mut f);
+            let departing = self.departing & (1 << k) != 0;
+            let tau = match first_root(&f, s.order, h, departing) {
+                Ok(Some(tau)) => tau,
+                Ok(None) => continue,
+                Err(top) => {
+                    return Err(SimError::Grazing {
+                        wall,
+                        t: t0 + top,
+                        normal_velocity: eval_with_derivative(&f, s.order, top).1,
+                    });
+                }
+            };
+            match best {
+                Some((_, b)) if b <= tau => second = Some(second.map_or(tau, |x| x.min(tau))),
+                _ => {
+                    second = best.map(|(_, b)| b);
+                    best = Some((k, tau));
+                }
+            }
+        }
+        if let (Some((k, a)), Some(b)) = (best, second)
+            && b - a <= self.simultaneity_window(t0 + a, h)
+        {
+            let other = m
+                .walls()
+                .iter()
+                .enumerate()
+                .find(|(j, w)| {
+                    *j != k && {
+                        m.surface_series(**w, &s, &mut f);
+                        first_root(&f, s.order, h, self.departing & (1 << j) != 0) == Ok(Some(b))
+                    }
+                })
+                .map_or(m.walls()[k], |(_, w)| *w);
+            return Err(SimError::Simultaneous {
+                first: m.walls()[k],
+                second: other,
+                t: t0 + a,
+            });
+        }
+        self.stats.steps += 1;
+        match best {
+            Some((k, tau)) => {
+                let (q, v) = s.state(tau);
+                let tc = self.advance_time(tau);
+                let collision = self.land(k, tc, &Phase { q, v }, t0, h)?;
+                self.stats.collisions += 1;
+                Ok(self.report(t0, Some(collision)))
+            }
+            None => {
+                let (q, v) = s.state(h);
+                let t1 = if h >= left {
+                    self.t_low = 0.0;
+                    t_end
+                } else {
+                    self.advance_time(h)
+                };
+                self.state = State { t: t1, q, v };
+                self.leave_walls();
+                self.project()?;
+                Ok(self.report(t0, None))
+            }
+        }
+    }
+
+    /// t + tau in compensated arithmetic (the error term kept in
+    /// `t_low`): the rounded sum of every step so far, not of the rounded
+    /// partial sums.
+    fn advance_time(&mut self, tau: f64) -> f64 {
+        let t = self.state.t;
+        let hi = t + tau;
+        // Knuth's two-sum: the exact error of t + tau.
+        let b = hi - t;
+        let err = (t - (hi - b)) + (tau - b);
+        let low = self.t_low + err;
+        let sum = hi + low;
+        self.t_low = low - (sum - hi);
+        sum
+    }
+}
+
+/// The first τ in (0, h] where the polynomial f (of `order`) falls to zero
+/// from above, if any; `departing` when the wall was just left (f(0) ≈ 0
+/// rising): then a root at the start is the departure, not a collision.
+/// `Err(τ)`: the motion turns back towards the wall at τ before f was
+/// seen positive (grazing on departure).
+fn first_root(c: &Coefficients, order: usize, h: f64, departing: bool) -> Result<Option<f64>, f64> {
+    let mut rate = [0.0; CAPACITY];
+    for k in 0..order {
+        rate[k] = (k + 1) as f64 * c[k + 1];
+    }
+    let low = order.saturating_sub(1);
+    let at = |tau: f64| eval_with_derivative(c, order, tau);
+    let (f0, r0) = (c[0], c[1]);
+    let mut leaving = departing && f0 <= 0.0 && r0 > 0.0;
+    if !leaving && f0 <= 0.0 {
+        // At or beyond the wall at the start and not leaving it.
+        return Ok(Some(0.0));
+    }
+    let mut prev = (0.0, f0, r0);
+    for j in 1..=SERIES_SAMPLES {
+        let tau = if j == SERIES_SAMPLES {
+            h
+        } else {
+            h * j as f64 / SERIES_SAMPLES as f64
+        };
+        let (f, r) = at(tau);
+        if leaving {
+            if f > 0.0 {
+                leaving = false;
+            } else if r <= 0.0 {
+                let top = root(&rate, low, prev.0, tau);
+                if eval(c, order, top) > 0.0 {
+                    return Ok(Some(root(c, order, top, tau)));
+                }
+                return Err(top);
+            }
+        } else if f <= 0.0 {
+            return Ok(Some(root(c, order, prev.0, tau)));
+        } else if prev.2 < 0.0 && r > 0.0 {
+            // Positive at both samples but turning: check the dip's bottom.
+            let bottom = root(&rate, low, prev.0, tau);
+            if eval(c, order, bottom) <= 0.0 {
+                return Ok(Some(root(c, order, prev.0, bottom)));
+            }
+        }
+        prev = (tau, f, r);
+    }
+    Ok(None)
+}
+
+/// A root of the polynomial in [a, b], where its sign changes: Newton's
+/// method from the secant point, bisection wherever Newton would leave the
+/// bracket, until the step is below rounding.
+fn root(c: &Coefficients, order: usize, mut a: f64, mut b: f64) -> f64 {
+    let (fa, fb) = (eval(c, order, a), eval(c, order, b));
+    if fa == 0.0 {
+        return a;
+    }
+    if fb == 0.0 {
+        return b;
+    }
+    let above_at_a = fa > 0.0;
+    let mut x = a - fa * (b - a) / (fb - fa);
+    if !(x > a && x < b) {
+        x = 0.5 * (a + b);
+    }
+    for _ in 0..SERIES_ROOT_ITERATIONS {
+        let (fx, dx) = eval_with_derivative(c, order, x);
+        if fx == 0.0 {
+            return x;
+        }
+        if (fx > 0.0) == above_at_a {
+            a = x;
+        } else {
+            b = x;
+        }
+        let newton = x - fx / dx;
+        let next = if newton > a && newton < b {
+            newton
+        } else {
+            0.5 * (a + b)
+        };
+        if next == x || (next - x).abs() <= f64::EPSILON * x.abs() {
+            return next;
+        }
+        x = next;
+    }
+    x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn poly(c: &[f64]) -> Coefficients {
+        let mut out = [0.0; CAPACITY];
+        out[..c.len()].copy_from_slice(c);
+        out
+    }
+
+    /// A flight z(τ) = 1 + 2τ − 4.905τ² lands at the descending root,
+    /// found to rounding.
+    #[test]
+    fn parabola_lands_at_its_root() {
+        let c = poly(&[1.0, 2.0, -4.905]);
+        let want = (2.0 + (4.0f64 + 4.0 * 4.905).sqrt()) / (2.0 * 4.905);
+        let tau = first_root(&c, 2, 1.0, false).unwrap().unwrap();
+        assert!(
+            (tau - want).abs() <= 2.0 * f64::EPSILON * want,
+            "{tau} {want}"
+        );
+        // Not within a shorter step.
+        assert_eq!(first_root(&c, 2, 0.5, false), Ok(None));
+    }
+
+    /// Just after a bounce (f(0) = 0, rising) the departure is not a
+    /// collision; the landing is.
+    #[test]
+    fn departure_is_not_a_collision() {
+        let c = poly(&[0.0, 2.0, -4.905]);
+        let want = 2.0 / 4.905;
+        let tau = first_root(&c, 2, 1.0, true).unwrap().unwrap();
+        assert!((tau - want).abs() <= 2.0 * f64::EPSILON * want);
+        // The same state not departing is at the wall already.
+        assert_eq!(first_root(&c, 2, 1.0, false), Ok(Some(0.0)));
+    }
+
+    /// A dip that touches down between two samples is found at its
+    /// bottom's side; a dip that stays above is not a collision.
+    #[test]
+    fn dips_between_samples() {
+        // f = (τ − 0.5)² − 1e-6: roots at 0.5 ± 0.001, between samples
+        // 0.5 and 0.5625 of h = 1? (0.5 is a sample: f < 0 there.)
+        let c = poly(&[0.25 - 1e-6, -1.0, 1.0]);
+        let tau = first_root(&c, 2, 1.0, false).unwrap().unwrap();
+        assert!((tau - 0.499).abs() < 1e-12, "{tau}");
+        // Bottom at 0.53 (between samples 0.5 and 0.5625), just below 0.
+        let c = poly(&[0.53 * 0.53 - 1e-8, -1.06, 1.0]);
+        let tau = first_root(&c, 2, 1.0, false).unwrap().unwrap();
+        assert!((tau - (0.53 - 1e-4)).abs() < 1e-12, "{tau}");
+        // Bottom just above 0.
+        let c = poly(&[0.53 * 0.53 + 1e-8, -1.06, 1.0]);
+        assert_eq!(first_root(&c, 2, 1.0, false), Ok(None));
+    }
+}
