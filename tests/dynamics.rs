@@ -146,8 +146,8 @@ fn closed_form<M: Dynamics<N> + FromParams, const N: usize>() {
         .closed_form_accelerations(&[0.5; N], &[0.0; N])
         .is_none()
     {
-        // Structured models solve at run time
-        // (`closed_forms_exist_where_expected` says which are which).
+        // A model without one (`closed_forms_exist_where_expected` says
+        // which have one) solves at run time.
         return;
     }
     for_random_cases::<M, N, N>(256, check_closed_form);
@@ -169,8 +169,10 @@ mod closed_form_solves_the_equations {
     for_each_model!(closed_form_test);
 }
 
-/// The generator derives q̈ in closed form wherever G⁻¹ is symbolic, and not
-/// for structured chains (instantaneous models have no `Dynamics` at all).
+/// The generator derives q̈ in closed form wherever G⁻¹ is symbolic, and
+/// writes the solve out by elimination for structured chains, so every
+/// model with coordinates has it (instantaneous models have no `Dynamics`
+/// at all).
 #[test]
 fn closed_forms_exist_where_expected() {
     fn has<M: Dynamics<N> + Default, const N: usize>() -> bool {
@@ -185,8 +187,9 @@ fn closed_forms_exist_where_expected() {
     assert!(has::<MassesOnLine, 2>());
     assert!(has::<Chain3, 3>());
     assert!(has::<Chain4Symbolic, 4>());
-    assert!(!has::<Chain4, 4>());
-    assert!(!has::<Chain8, 8>());
+    assert!(has::<Chain4, 4>());
+    assert!(has::<Chain8, 8>());
+    assert!(has::<BallWallQuaternion, 6>());
 }
 
 /// Where the closed form is not finite (G singular), `qdd` falls back to the

@@ -12,7 +12,8 @@ use dalembert::for_each_model;
 use dalembert::models::*;
 use dalembert::runtime::Rows;
 use dalembert::runtime::prelude::*;
-use dalembert::runtime::simulate::{Settings, Simulator, State};
+use dalembert::runtime::simulate::{Integrator, Settings, Simulator, State, Taylor};
+use dalembert::runtime::taylor::{CAPACITY, Series};
 use dalembert_codegen::interpret::Interpreted;
 
 use common::lcg;
@@ -107,8 +108,28 @@ fn same_functions<M: Surfaces<N>, I: Surfaces<N>, const N: usize>(
         &c.initial_velocities(),
         &i.initial_velocities(),
     );
+    // The Taylor series, where the model has them (both or neither).
+    let (mut tc, mut ti) = (Series::at(q, v), Series::at(q, v));
+    let has = c.taylor_series(&mut tc, 12);
+    assert_eq!(
+        has,
+        i.taylor_series(&mut ti, 12),
+        "{name}: series offered alike"
+    );
+    if has {
+        assert_eq!(tc.order, ti.order);
+        for k in 0..N {
+            agree(&format!("{name} series q{k}"), &tc.q[k], &ti.q[k]);
+            agree(&format!("{name} series v{k}"), &tc.v[k], &ti.v[k]);
+        }
+    }
     assert_eq!(c.walls().len(), i.walls().len());
     for (&wc, &wi) in c.walls().iter().zip(i.walls()) {
+        if has {
+            let (mut fc, mut fi) = ([0.0; CAPACITY], [0.0; CAPACITY]);
+            assert!(c.surface_series(wc, &tc, &mut fc) && i.surface_series(wi, &tc, &mut fi));
+            agree(&format!("{name} {} f series", c.wall_name(wc)), &fc, &fi);
+        }
         let w = format!("{name} {}", c.wall_name(wc));
         assert_eq!(c.wall_name(wc), i.wall_name(wi));
         agree(
@@ -167,7 +188,7 @@ fn functions_agree<M: Surfaces<N> + FromParams, const N: usize>(module: &str) {
 
 /// A run of 5 s from the file's initial state: the same steps, the same
 /// collisions, the same states, energies, T and V.
-fn runs_agree<M: Surfaces<N> + FromParams, const N: usize>(module: &str) {
+fn runs_agree<M: Surfaces<N> + FromParams, const N: usize>(module: &str, settings: Settings) {
     let c = M::with_params(Default::default());
     let i = interpreted::<N>(module);
     let start = State {
@@ -175,7 +196,6 @@ fn runs_agree<M: Surfaces<N> + FromParams, const N: usize>(module: &str) {
         q: c.initial_coordinates(),
         v: c.initial_velocities(),
     };
-    let settings = Settings::default();
     let (Ok(mut sc), Ok(mut si)) = (
         Simulator::new(&c, start, settings),
         Simulator::new(&i, start, settings),
@@ -220,7 +240,16 @@ macro_rules! interpreted_test {
         #[test]
         fn $module() {
             functions_agree::<$ty, $n>(stringify!($module));
-            runs_agree::<$ty, $n>(stringify!($module));
+            runs_agree::<$ty, $n>(stringify!($module), Settings::default());
+            let m = <$ty>::with_params(Default::default());
+            let mut s = Series::at(&m.initial_coordinates(), &m.initial_velocities());
+            if m.taylor_series(&mut s, 1) {
+                let taylor = Settings {
+                    integrator: Integrator::Taylor(Taylor::default()),
+                    ..Settings::default()
+                };
+                runs_agree::<$ty, $n>(stringify!($module), taylor);
+            }
         }
     };
 }

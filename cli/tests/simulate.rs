@@ -297,3 +297,54 @@ fn a_model_file_simulates_without_writing_rust() {
     let (ok, _, stderr) = dalembert(&["simulate", file, "--set", "R=5", "--out", out]);
     assert!(!ok && stderr.contains("derived parameter"), "{stderr}");
 }
+
+/// `--integrator taylor` runs a built-in model and a model file (through
+/// the interpreter's series) to the same collisions as the default method,
+/// and a tolerance outside (0, 1) is refused.
+#[test]
+fn taylor_integrator_from_the_command_line() {
+    for (model, name) in [
+        ("ball_bounce", "ball_bounce"),
+        ("models/pendulum_wall.toml", "pendulum_wall"),
+    ] {
+        let model = if model.ends_with(".toml") {
+            format!("{}/../{model}", env!("CARGO_MANIFEST_DIR"))
+        } else {
+            model.to_string()
+        };
+        let mut collisions = Vec::new();
+        for integrator in ["dormand-prince", "taylor"] {
+            let dir = scratch(&format!("simulate-{name}-{integrator}"));
+            let out = dir.to_str().unwrap();
+            let (ok, stdout, stderr) = dalembert(&[
+                "simulate",
+                &model,
+                "--t-end",
+                "3",
+                "--integrator",
+                integrator,
+                "--out",
+                out,
+            ]);
+            assert!(ok, "{stdout}\n{stderr}");
+            let csv = std::fs::read_to_string(dir.join(format!("{name}.csv"))).unwrap();
+            let hits = csv
+                .lines()
+                .skip(1)
+                .filter(|l| !l.ends_with(','))
+                .count();
+            collisions.push(hits);
+        }
+        assert!(collisions[0] > 0, "{name}: {collisions:?}");
+        assert_eq!(collisions[0], collisions[1], "{name}");
+    }
+    let (ok, _, stderr) = dalembert(&[
+        "simulate",
+        "ball_bounce",
+        "--integrator",
+        "taylor",
+        "--tolerance",
+        "2",
+    ]);
+    assert!(!ok && stderr.contains("--tolerance"), "{stderr}");
+}

@@ -24,7 +24,8 @@ pub enum Quantity {
     Forcing,
     /// Ȧq̇.
     ConstraintDrift,
-    /// q̈ in closed form (only where G⁻¹ is exact).
+    /// q̈ written out: the exact closed form where G⁻¹ is exact, else the
+    /// solve of the equations of motion by elimination.
     Accelerations,
     /// A wall's f(q).
     Surface,
@@ -209,7 +210,7 @@ pub const TABLE: &[Spec] = &[
         name: "accelerations",
         inputs: Inputs::Phase,
         shape: Shape::Vector,
-        doc: "q̈ of the equations of motion G(q) q̈ + h(q, q̇) = A(q)ᵀλ, A(q) q̈ + Ȧq̇ = 0, in closed form (q̇ should satisfy A(q) q̇ = 0). Non-finite where G is singular.",
+        doc: "q̈ of the equations of motion G(q) q̈ + h(q, q̇) = A(q)ᵀλ, A(q) q̈ + Ȧq̇ = 0, written out: in exact closed form where G⁻¹ is exact, else as the solve by elimination (G = LDLᵀ, then the constraints' Schur complement; q̇ should satisfy A(q) q̇ = 0). Non-finite where G is singular.",
         capability: Capability::Dynamics,
         method: Some(("closed_form_accelerations", Forward::Some)),
     },

@@ -131,10 +131,11 @@ pub trait Dynamics<const N: usize>: Model<N, N> {
     /// A q̈ + Ȧq̇ = 0.
     fn constraint_drift(&self, q: &[f64; N], v: &[f64; N]) -> [f64; N];
 
-    /// q̈ of the equations of motion in closed form, where the generator
-    /// derived one (G⁻¹ exact); `None` (the default) means "solve
-    /// G q̈ + h = Aᵀλ numerically", as [`crate::dynamics::accelerations`]
-    /// does. The result is non-finite where G is singular.
+    /// q̈ of the equations of motion written out by the generator: the exact
+    /// closed form where G⁻¹ is exact, else the solve by elimination as
+    /// straight-line code; `None` (the default) means "solve G q̈ + h = Aᵀλ
+    /// numerically", as [`crate::dynamics::accelerations`] does. The result
+    /// is non-finite where G is singular.
     fn closed_form_accelerations(&self, q: &[f64; N], v: &[f64; N]) -> Option<[f64; N]> {
         let _ = (q, v);
         None
@@ -143,9 +144,10 @@ pub trait Dynamics<const N: usize>: Model<N, N> {
     /// The Taylor series of the motion through the state held at order 0
     /// of `series` (q(t₀), q̇(t₀)): fills its coefficients of orders 1 to
     /// `order` (at most [`crate::taylor::MAX_ORDER`]) and sets its order.
-    /// Generated models have it where q̈ is in closed form (the Taylor
-    /// transform of that program); `false` (the default) means the model
-    /// has none and the series is untouched.
+    /// Generated models have it wherever they write q̈ out (the Taylor
+    /// transform of that program, [`Dynamics::closed_form_accelerations`]);
+    /// `false` (the default) means the model has none and the series is
+    /// untouched.
     fn taylor_series(&self, series: &mut Series<N>, order: usize) -> bool {
         let _ = (series, order);
         false

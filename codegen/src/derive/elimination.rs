@@ -1,12 +1,13 @@
 //! Pass 4b: each wall's collision map written out by elimination, over one
 //! program for G and B, and the choice between it and the exact closed
-//! forms by per-call cost.
+//! forms by per-call cost; and q̈ written out the same way where it has no
+//! exact closed form (a dense G).
 
 use std::ops::Range;
 
 use symbolica::prelude::*;
 
-use super::mechanics::Exact;
+use super::mechanics::{Exact, Raw};
 use super::output::{Choice, Form, Function};
 use super::symbols::Symbols;
 use super::{Compiler, is_zero};
@@ -62,6 +63,34 @@ pub fn collision(
     let v = sym.params.len() + sym.coords.len();
     Ok(f.program
         .reflect_by_elimination(&layout, v)
+        .map(|program| Function { program, ..f }))
+}
+
+/// q̈ of G q̈ + h = Aᵀλ, A q̈ + Ȧq̇ = 0 by elimination (G = LDLᵀ and the
+/// constrained solve written out over one program for G, A, h and Ȧq̇), for
+/// a model whose q̈ has no exact closed form. `None` where a pivot is
+/// structurally zero.
+pub fn motion(
+    exact: &Exact,
+    raw: &Raw,
+    compile: &Compiler,
+    cx: &mut Collector,
+    span: &Range<usize>,
+) -> Result<Option<Function>, Reported> {
+    let mut outputs = Outputs::default();
+    let layout = outputs.layout(exact, &raw.a_rows);
+    let forcing: Vec<Option<usize>> = raw.forcing.iter().map(|h| outputs.place(h)).collect();
+    let drift: Vec<Option<usize>> = raw
+        .drift
+        .iter()
+        .take(raw.a_rows.len())
+        .map(|c| outputs.place(c))
+        .collect();
+    let Some(f) = compile.applicable(cx, Quantity::Accelerations, &outputs.0, 0, span)? else {
+        return Ok(None);
+    };
+    Ok(f.program
+        .motion_by_elimination(&layout, &forcing, &drift)
         .map(|program| Function { program, ..f }))
 }
 

@@ -97,8 +97,13 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
     ] {
         functions.push(compile.applicable(cx, quantity, &outputs, rows, t_span)?);
     }
-    if let Some(x) = &accelerations {
-        functions.push(compile.applicable(cx, Quantity::Accelerations, x, 0, t_span)?);
+    match &accelerations {
+        Some(x) => functions.push(compile.applicable(cx, Quantity::Accelerations, x, 0, t_span)?),
+        // No exact closed form (a dense G): the solve written out.
+        None if model.kind == Kind::Coordinates && raw.drift.len() >= raw.a_rows.len() => {
+            functions.push(elimination::motion(&exact, &raw, &compile, cx, t_span)?)
+        }
+        None => {}
     }
     functions.push(initial_state(&sym, &compile, cx)?);
     let functions = functions.into_iter().flatten().collect();

@@ -148,6 +148,17 @@ pub enum InterpretError {
     },
 }
 
+/// A program's outputs at `inputs`, computed as the emitted code computes
+/// them (the tape).
+fn run_program(p: &crate::program::Program, inputs: &[f64]) -> Vec<f64> {
+    let tape = Tape::new(p);
+    let mut r = tape.init.clone();
+    let n = inputs.len().min(tape.inputs);
+    r[..n].copy_from_slice(&inputs[..n]);
+    tape.run(&mut r);
+    tape.outputs(&r).to_vec()
+}
+
 /// Names live as long as the process: an interpreted model is built once
 /// per model file, and the runtime's traits hand out `&[&str]`.
 fn leak_names(names: impl Iterator<Item = String>) -> &'static [&'static str] {
@@ -418,7 +429,8 @@ impl<const N: usize> Dynamics<N> for Interpreted<N> {
         let q: [f64; N] = std::array::from_fn(|i| series.q[i][0]);
         let v: [f64; N] = std::array::from_fn(|i| series.v[i][0]);
         let order = order.min(MAX_ORDER);
-        let e = motion.motion(&self.values, &q, &v, order);
+        let numbers = motion.number_values(&self.values, run_program);
+        let e = motion.motion(&numbers, &q, &v, order);
         for i in 0..N {
             series.q[i] = e.q[i];
             series.v[i] = e.v[i];
@@ -444,7 +456,8 @@ impl<const N: usize> Surfaces<N> for Interpreted<N> {
             v: series.v.to_vec(),
             temps: Vec::new(),
         };
-        *out = t.along(&self.values, &mut e, series.order);
+        let numbers = t.number_values(&self.values, run_program);
+        *out = t.along(&numbers, &mut e, series.order);
         true
     }
 }

@@ -342,8 +342,14 @@ pub struct Evaluation {
 
 impl Transform {
     /// The time-constant values at the parameters `params`: a vector that
-    /// [`Term::Number`] slots index by [`Transform::number_index`].
-    pub fn number_values(&self, params: &[f64]) -> Vec<f64> {
+    /// [`Term::Number`] slots index by [`Transform::number_index`]. `eval`
+    /// runs a program on its inputs (the interpreter passes its tape, which
+    /// computes as emitted code does; [`Program::eval`] serves tests).
+    pub fn number_values(
+        &self,
+        params: &[f64],
+        eval: impl FnOnce(&Program, &[f64]) -> Vec<f64>,
+    ) -> Vec<f64> {
         let mut inputs = vec![0.0; self.numbers.inputs];
         inputs[..params.len()].copy_from_slice(params);
         let mut p = self.numbers.clone();
@@ -360,7 +366,7 @@ impl Transform {
         p.instrs
             .extend((0..written).map(|k| Instr::Assign(Slot::Out(k), Slot::Temp(k))));
         p.outputs = written;
-        let temps = p.eval(&inputs);
+        let temps = eval(&p, &inputs);
         let mut all = inputs;
         all.extend(&self.numbers.consts);
         all.extend(temps);
@@ -434,8 +440,7 @@ impl Transform {
     /// The Taylor series of the motion q̈ = this program's outputs through
     /// (q, v), to `order` (for tests and the interpreter; emitted code does
     /// the same in straight-line Rust).
-    pub fn motion(&self, params: &[f64], q: &[f64], v: &[f64], order: usize) -> Evaluation {
-        let numbers = self.number_values(params);
+    pub fn motion(&self, numbers: &[f64], q: &[f64], v: &[f64], order: usize) -> Evaluation {
         let mut e = Evaluation {
             q: vec![[0.0; tay::CAPACITY]; q.len()],
             v: vec![[0.0; tay::CAPACITY]; v.len()],
@@ -449,11 +454,11 @@ impl Transform {
         }
         let order = order.min(tay::MAX_ORDER);
         for k in 0..order {
-            self.order(&mut e, &numbers, k);
+            self.order(&mut e, numbers, k);
             let kf = (k + 1) as f64;
             for i in 0..v.len() {
                 e.q[i][k + 1] = e.v[i][k] / kf;
-                e.v[i][k + 1] = self.output(&e, &numbers, i, k) / kf;
+                e.v[i][k + 1] = self.output(&e, numbers, i, k) / kf;
             }
         }
         e
@@ -461,8 +466,7 @@ impl Transform {
 
     /// The coefficients of the first output along the coordinates' series
     /// in `e` (its temporaries overwritten), orders 0 to `order`.
-    pub fn along(&self, params: &[f64], e: &mut Evaluation, order: usize) -> Coefficients {
-        let numbers = self.number_values(params);
+    pub fn along(&self, numbers: &[f64], e: &mut Evaluation, order: usize) -> Coefficients {
         e.temps = vec![[0.0; tay::CAPACITY]; self.temps];
         let mut out = [0.0; tay::CAPACITY];
         for (k, o) in out
@@ -470,8 +474,8 @@ impl Transform {
             .enumerate()
             .take(order.min(tay::MAX_ORDER) + 1)
         {
-            self.order(e, &numbers, k);
-            *o = self.output(e, &numbers, 0, k);
+            self.order(e, numbers, k);
+            *o = self.output(e, numbers, 0, k);
         }
         out
     }
@@ -513,7 +517,8 @@ mod tests {
         // Only the product with sin q is series work.
         assert_eq!(t.ops.len(), 2, "{:?}", t.ops);
         let (gv, lv, q0, v0) = (9.81, 2.0, 0.7, -0.4);
-        let e = t.motion(&[gv, lv], &[q0], &[v0], 20);
+        let numbers = t.number_values(&[gv, lv], |p, x| p.eval(x));
+        let e = t.motion(&numbers, &[q0], &[v0], 20);
         let w = gv / lv;
         assert_eq!(e.q[0][1], v0);
         assert!((e.q[0][2] - (-w * q0.sin() / 2.0)).abs() < 1e-16);
@@ -571,7 +576,8 @@ mod tests {
         };
         e.q[0][0] = 2.0;
         e.q[0][1] = 1.0;
-        let c = tr.along(&[0.0], &mut e, 30);
+        let numbers = tr.number_values(&[0.0], |p, x| p.eval(x));
+        let c = tr.along(&numbers, &mut e, 30);
         for tau in [0.0, 0.1, -0.2, 0.3] {
             let got = tay::eval(&c, 30, tau);
             let want = f(2.0 + tau);

@@ -455,7 +455,7 @@ impl BallWallEuler {
         let o1: f32 = t3 + t6;
         [o0, o1, 0.0, 0.0, 0.0]
     }
-    /// q̈ of the equations of motion G(q) q̈ + h(q, q̇) = A(q)ᵀλ, A(q) q̈ + Ȧq̇ = 0, in closed form (q̇ should satisfy A(q) q̇ = 0). Non-finite where G is singular.
+    /// q̈ of the equations of motion G(q) q̈ + h(q, q̇) = A(q)ᵀλ, A(q) q̈ + Ȧq̇ = 0, written out: in exact closed form where G⁻¹ is exact, else as the solve by elimination (G = LDLᵀ, then the constraints' Schur complement; q̇ should satisfy A(q) q̇ = 0). Non-finite where G is singular.
     #[inline]
     #[allow(unused_variables, clippy::approx_constant)]
     pub fn accelerations(&self, q: &[f32; 5], v: &[f32; 5]) -> [f32; 5] {
