@@ -328,11 +328,7 @@ fn taylor_integrator_from_the_command_line() {
             ]);
             assert!(ok, "{stdout}\n{stderr}");
             let csv = std::fs::read_to_string(dir.join(format!("{name}.csv"))).unwrap();
-            let hits = csv
-                .lines()
-                .skip(1)
-                .filter(|l| !l.ends_with(','))
-                .count();
+            let hits = csv.lines().skip(1).filter(|l| !l.ends_with(',')).count();
             collisions.push(hits);
         }
         assert!(collisions[0] > 0, "{name}: {collisions:?}");
