@@ -1,12 +1,20 @@
 //! Taylor's method beside Dormand–Prince 5(4) (rtol 1e-10, atol 1e-12, the
 //! CLI's default), in one run and in thread CPU time:
 //!
+//! - `series/ball_bounce/*`: one step's parts alone: the generated
+//!   `motion_series` to the default order (20), the floor's
+//!   `surface_series` along it, the state at one instant on the series;
 //! - `bounce/{dormand_prince,taylor}/{100,1000,10000}`: the §3.2.1
 //!   nonholonomic pendulum from just after a bounce, through that many
 //!   bounces (throughput in bounces);
-//! - `rolling/ball_wall_euler/{dormand_prince,taylor}`: the §3.1 ball in
-//!   Euler angles driven into the wall by a uniform force, through 100
-//!   impacts;
+//! - `rolling/{ball_wall_euler,ball_wall_quaternion}/{dormand_prince,taylor}`:
+//!   the §3.1 ball, its attitude in Euler angles or as a unit quaternion
+//!   (holonomic |e| = 1), driven into the wall by a uniform force, through
+//!   100 impacts;
+//! - `chain/{chain_3,chain_8}/{dormand_prince,taylor}`: the n-link chain's
+//!   tip on the floor from the model file's start, through 100 impacts
+//!   (chain_3's q̈ in closed form, chain_8's by elimination; the motion is
+//!   chaotic, so the two methods' impacts are not the same ones);
 //! - `pendulum/{dormand_prince,taylor}`: the Cartesian pendulum (holonomic
 //!   rod) against its wall, through 100 impacts.
 //!
@@ -19,7 +27,9 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use dalembert::models::{BallBounce, BallWallEuler, PendulumWall, ball_bounce};
+use dalembert::models::{
+    BallBounce, BallWallEuler, BallWallQuaternion, Chain3, Chain8, PendulumWall, ball_bounce,
+};
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
     DormandPrince, Integrator, Settings, Simulator, State, Stats, Taylor,
@@ -81,6 +91,36 @@ fn bounce_run(ball: &BallBounce, settings: Settings, bounces: u64) -> (Stats, f6
         .unwrap();
     assert_eq!(stats.collisions, bounces);
     (stats, dt, de)
+}
+
+/// The series of one step alone: `motion_series` to the default order
+/// from §3.2.1's start, and the floor's `surface_series` along it.
+fn series(c: &mut Criterion<ThreadCpuTime>) {
+    use dalembert::runtime::taylor::{CAPACITY, Series};
+    let ball = BallBounce::default();
+    let start = bounce_start(&ball);
+    let order = Taylor::default().order();
+    let mut g = c.benchmark_group("series/ball_bounce");
+    g.bench_function("motion_series", |b| {
+        b.iter(|| {
+            let mut s = Series::at(black_box(&start.q), black_box(&start.v));
+            ball.taylor_series(&mut s, order);
+            s
+        })
+    });
+    let mut s = Series::at(&start.q, &start.v);
+    ball.taylor_series(&mut s, order);
+    g.bench_function("surface_series", |b| {
+        b.iter(|| {
+            let mut f = [0.0; CAPACITY];
+            ball.surface_series(ball_bounce::Wall::Floor, black_box(&s), &mut f);
+            f
+        })
+    });
+    g.bench_function("state_at", |b| {
+        b.iter(|| black_box(&s).state(black_box(0.3)))
+    });
+    g.finish();
 }
 
 fn bounce(c: &mut Criterion<ThreadCpuTime>) {
@@ -172,6 +212,27 @@ fn rolling(c: &mut Criterion<ThreadCpuTime>) {
         v: ball.initial_velocities(),
     };
     paired(c, "rolling/ball_wall_euler", &ball, start);
+    let quat = BallWallQuaternion::default();
+    let start = State {
+        t: 0.0,
+        q: quat.initial_coordinates(),
+        v: quat.initial_velocities(),
+    };
+    paired(c, "rolling/ball_wall_quaternion", &quat, start);
+}
+
+fn chain(c: &mut Criterion<ThreadCpuTime>) {
+    fn one<M: Surfaces<N> + Default, const N: usize>(c: &mut Criterion<ThreadCpuTime>) {
+        let m = M::default();
+        let start = State {
+            t: 0.0,
+            q: m.initial_coordinates(),
+            v: m.initial_velocities(),
+        };
+        paired(c, &format!("chain/{}", m.name()), &m, start);
+    }
+    one::<Chain3, 3>(c);
+    one::<Chain8, 8>(c);
 }
 
 fn pendulum(c: &mut Criterion<ThreadCpuTime>) {
@@ -187,6 +248,6 @@ fn pendulum(c: &mut Criterion<ThreadCpuTime>) {
 criterion_group! {
     name = benches;
     config = Criterion::default().with_measurement(ThreadCpuTime);
-    targets = bounce, rolling, pendulum
+    targets = series, bounce, rolling, chain, pendulum
 }
 criterion_main!(benches);

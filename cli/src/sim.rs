@@ -29,8 +29,7 @@ pub enum Method {
     /// Classical Runge–Kutta with a fixed step (`--step`).
     Rk4,
     /// Taylor's method on the model's generated series, collisions found on
-    /// the step's polynomial (`--tolerance`; models whose q̈ is in closed
-    /// form).
+    /// the step's polynomial (`--tolerance`).
     Taylor,
 }
 

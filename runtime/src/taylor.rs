@@ -59,12 +59,17 @@ impl<const N: usize> Series<N> {
         s
     }
 
-    /// The state at τ on the series (Horner's scheme).
+    /// The state at τ on the series (Horner's scheme, every component in
+    /// step so that the 2N chains run side by side; each is [`eval`]'s).
     pub fn state(&self, tau: f64) -> ([f64; N], [f64; N]) {
-        (
-            core::array::from_fn(|i| eval(&self.q[i], self.order, tau)),
-            core::array::from_fn(|i| eval(&self.v[i], self.order, tau)),
-        )
+        let (mut q, mut v) = ([0.0; N], [0.0; N]);
+        for k in (0..=self.order.min(MAX_ORDER)).rev() {
+            for i in 0..N {
+                q[i] = q[i] * tau + self.q[i][k];
+                v[i] = v[i] * tau + self.v[i][k];
+            }
+        }
+        (q, v)
     }
 }
 
@@ -87,25 +92,53 @@ pub fn eval_with_derivative(c: &Coefficients, order: usize, tau: f64) -> (f64, f
     (p, dp)
 }
 
+/// Σᵢ xᵢ·y₍ₙ₋₁₋ᵢ₎ over n = min(|x|, |y|), in four independent partial
+/// sums: the convolutions below are short dot products whose cost is the
+/// latency of one long chain of additions, and four chains run side by
+/// side.
+#[inline(always)]
+fn reversed_dot(x: &[f64], y: &[f64]) -> f64 {
+    let n = x.len().min(y.len());
+    let (x, y) = (&x[..n], &y[..n]);
+    let mut s = [0.0; 4];
+    let mut i = 0;
+    while i + 4 <= n {
+        s[0] += x[i] * y[n - 1 - i];
+        s[1] += x[i + 1] * y[n - 2 - i];
+        s[2] += x[i + 2] * y[n - 3 - i];
+        s[3] += x[i + 3] * y[n - 4 - i];
+        i += 4;
+    }
+    while i < n {
+        s[0] += x[i] * y[n - 1 - i];
+        i += 1;
+    }
+    (s[0] + s[1]) + (s[2] + s[3])
+}
+
+/// j·aⱼ for j = 1..=k, at index j − 1: the derivative's coefficients
+/// (times k), which sin, cos and exp convolve with.
+#[inline(always)]
+fn scaled(a: &Coefficients, k: usize) -> Coefficients {
+    let mut d = [0.0; CAPACITY];
+    for (j, (dj, aj)) in d.iter_mut().zip(&a[1..=k]).enumerate() {
+        *dj = (j + 1) as f64 * aj;
+    }
+    d
+}
+
 /// Coefficient k of a·b.
 #[inline]
 pub fn mul(a: &Coefficients, b: &Coefficients, k: usize) -> f64 {
-    let mut acc = 0.0;
-    for (x, y) in a[..=k].iter().zip(b[..=k].iter().rev()) {
-        acc += x * y;
-    }
-    acc
+    reversed_dot(&a[..=k], &b[..=k])
 }
 
 /// Coefficient k of a², from a's coefficients (half the products of
 /// [`mul`]).
 #[inline]
 pub fn square(a: &Coefficients, k: usize) -> f64 {
-    let mut acc = 0.0;
-    for j in 0..k.div_ceil(2) {
-        acc += a[j] * a[k - j];
-    }
-    acc *= 2.0;
+    let half = k.div_ceil(2);
+    let mut acc = 2.0 * reversed_dot(&a[..half], &a[k + 1 - half..=k]);
     if k % 2 == 0 {
         acc += a[k / 2] * a[k / 2];
     }
@@ -118,11 +151,7 @@ pub fn recip(c: &Coefficients, a: &Coefficients, k: usize) -> f64 {
     if k == 0 {
         return 1.0 / a[0];
     }
-    let mut acc = 0.0;
-    for (x, y) in a[1..=k].iter().zip(c[..k].iter().rev()) {
-        acc += x * y;
-    }
-    -acc * c[0]
+    -reversed_dot(&a[1..=k], &c[..k]) * c[0]
 }
 
 /// Coefficient k of c = √a, from a's coefficients and c's below k.
@@ -131,10 +160,11 @@ pub fn sqrt(c: &Coefficients, a: &Coefficients, k: usize) -> f64 {
     if k == 0 {
         return libm::sqrt(a[0]);
     }
-    let mut acc = 0.0;
-    for j in 1..k {
-        acc += c[j] * c[k - j];
-    }
+    let acc = if k > 1 {
+        reversed_dot(&c[1..k], &c[1..k])
+    } else {
+        0.0
+    };
     (a[k] - acc) / (2.0 * c[0])
 }
 
@@ -158,11 +188,7 @@ pub fn exp(c: &Coefficients, a: &Coefficients, k: usize) -> f64 {
     if k == 0 {
         return libm::exp(a[0]);
     }
-    let mut acc = 0.0;
-    for j in 1..=k {
-        acc += j as f64 * a[j] * c[k - j];
-    }
-    acc / k as f64
+    reversed_dot(&scaled(a, k)[..k], &c[..k]) / k as f64
 }
 
 /// Coefficient k of c = ln(a), from a's coefficients and c's below k.
@@ -171,10 +197,11 @@ pub fn log(c: &Coefficients, a: &Coefficients, k: usize) -> f64 {
     if k == 0 {
         return libm::log(a[0]);
     }
-    let mut acc = 0.0;
-    for j in 1..k {
-        acc += j as f64 * c[j] * a[k - j];
-    }
+    let acc = if k > 1 {
+        reversed_dot(&scaled(c, k - 1)[..k - 1], &a[1..k])
+    } else {
+        0.0
+    };
     (a[k] - acc / k as f64) / a[0]
 }
 
@@ -185,14 +212,18 @@ pub fn sin_cos(s: &Coefficients, c: &Coefficients, a: &Coefficients, k: usize) -
     if k == 0 {
         return libm::sincos(a[0]);
     }
-    let (mut ss, mut cc) = (0.0, 0.0);
-    for j in 1..=k {
-        let ja = j as f64 * a[j];
-        ss += ja * c[k - j];
-        cc += ja * s[k - j];
-    }
     let kf = k as f64;
+    let d = scaled(a, k);
+    let ss = reversed_dot(&d[..k], &c[..k]);
+    let cc = reversed_dot(&d[..k], &s[..k]);
     (ss / kf, -cc / kf)
+}
+
+/// The degree of the polynomial of `order` with coefficients `c`: the
+/// highest k ≤ order with cₖ ≠ 0 (0 for the zero polynomial).
+pub fn degree(c: &Coefficients, order: usize) -> usize {
+    let order = order.min(MAX_ORDER);
+    c[..=order].iter().rposition(|x| *x != 0.0).unwrap_or(0)
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@ use super::thresholds::{SERIES_ROOT_ITERATIONS, SERIES_SAMPLES};
 use super::{SimError, Simulator, State, Step};
 use crate::Surfaces;
 use crate::dynamics::DynamicsError;
-use crate::taylor::{CAPACITY, Coefficients, Series, eval, eval_with_derivative};
+use crate::taylor::{CAPACITY, Coefficients, Series, degree, eval, eval_with_derivative};
 
 /// Whether `m` has the series Taylor's method needs (of the motion and of
 /// every wall's f).
@@ -150,6 +150,9 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
 /// `Err(τ)`: the motion turns back towards the wall at τ before f was
 /// seen positive (grazing on departure).
 fn first_root(c: &Coefficients, order: usize, h: f64, departing: bool) -> Result<Option<f64>, f64> {
+    // Trailing zeros cost evaluations and say nothing (a flight's f is
+    // often of degree 2).
+    let order = degree(c, order);
     let mut rate = [0.0; CAPACITY];
     for k in 0..order {
         rate[k] = (k + 1) as f64 * c[k + 1];

@@ -173,7 +173,8 @@ pub enum SimError<W> {
     /// A setting is out of range (a non-positive step or tolerance).
     BadSettings,
     /// Taylor's method was asked for, but the model has no Taylor series
-    /// (its q̈ is not in closed form, or a wall has no series of f).
+    /// of its motion or of a wall's f (generated models with coordinates
+    /// have them; a hand-written model may not).
     NoSeries,
     /// The model has more walls than the simulator tracks
     /// ([`super::thresholds::MAX_WALLS`]).
@@ -233,7 +234,7 @@ impl<W: core::fmt::Debug> core::fmt::Display for SimError<W> {
             SimError::BadSettings => write!(f, "a step or tolerance is not positive and finite"),
             SimError::NoSeries => write!(
                 f,
-                "Taylor's method needs the model's Taylor series, which it has only where q̈ is in closed form"
+                "Taylor's method needs the model's Taylor series (Dynamics::taylor_series, Surfaces::surface_series), which this model does not have"
             ),
             SimError::TooManyWalls { walls } => write!(
                 f,

@@ -29,7 +29,7 @@ pub enum Integrator {
     /// Dormand–Prince 5(4) with error control.
     DormandPrince(DormandPrince),
     /// Taylor's method on the model's generated series, with events found
-    /// on the step's polynomial (models whose q̈ is in closed form).
+    /// on the step's polynomial.
     Taylor(Taylor),
 }
 
