@@ -204,32 +204,26 @@ fn paired<M: Surfaces<N>, const N: usize>(
     g.finish();
 }
 
+/// The model file's initial state.
+fn initial<M: Dynamics<N>, const N: usize>(m: &M) -> State<N> {
+    State {
+        t: 0.0,
+        q: m.initial_coordinates(),
+        v: m.initial_velocities(),
+    }
+}
+
 fn rolling(c: &mut Criterion<ThreadCpuTime>) {
     let ball = BallWallEuler::default();
-    let start = State {
-        t: 0.0,
-        q: ball.initial_coordinates(),
-        v: ball.initial_velocities(),
-    };
-    paired(c, "rolling/ball_wall_euler", &ball, start);
+    paired(c, "rolling/ball_wall_euler", &ball, initial(&ball));
     let quat = BallWallQuaternion::default();
-    let start = State {
-        t: 0.0,
-        q: quat.initial_coordinates(),
-        v: quat.initial_velocities(),
-    };
-    paired(c, "rolling/ball_wall_quaternion", &quat, start);
+    paired(c, "rolling/ball_wall_quaternion", &quat, initial(&quat));
 }
 
 fn chain(c: &mut Criterion<ThreadCpuTime>) {
     fn one<M: Surfaces<N> + Default, const N: usize>(c: &mut Criterion<ThreadCpuTime>) {
         let m = M::default();
-        let start = State {
-            t: 0.0,
-            q: m.initial_coordinates(),
-            v: m.initial_velocities(),
-        };
-        paired(c, &format!("chain/{}", m.name()), &m, start);
+        paired(c, &format!("chain/{}", m.name()), &m, initial(&m));
     }
     one::<Chain3, 3>(c);
     one::<Chain8, 8>(c);
