@@ -139,7 +139,7 @@ pub fn mul(a: &Coefficients, b: &Coefficients, k: usize) -> f64 {
 pub fn square(a: &Coefficients, k: usize) -> f64 {
     let half = k.div_ceil(2);
     let mut acc = 2.0 * reversed_dot(&a[..half], &a[k + 1 - half..=k]);
-    if k % 2 == 0 {
+    if k.is_multiple_of(2) {
         acc += a[k / 2] * a[k / 2];
     }
     acc

@@ -64,7 +64,7 @@ pub(super) fn functions(d: &Ctx) -> TokenStream {
         /// `s` (q(t₀), q̇(t₀)): fills its orders 1 to `order` (at most
         /// `taylor::MAX_ORDER`) by the Taylor transform of `accelerations`,
         /// one order at a time.
-        #[allow(unused_variables, clippy::approx_constant, clippy::needless_range_loop)]
+        #[allow(unused_variables, clippy::approx_constant, clippy::needless_range_loop, clippy::manual_memcpy)]
         pub fn motion_series(&self, s: &mut ::dalembert_runtime::taylor::Series<#n>, order: usize) {
             let order = order.min(::dalembert_runtime::taylor::MAX_ORDER);
             #motion_prelude
@@ -87,7 +87,7 @@ pub(super) fn functions(d: &Ctx) -> TokenStream {
         let out = output(d, t, 0);
         quote! {
             #[doc = #doc]
-            #[allow(unused_variables, clippy::approx_constant, clippy::needless_range_loop)]
+            #[allow(unused_variables, clippy::approx_constant, clippy::needless_range_loop, clippy::manual_memcpy)]
             pub fn #name(
                 &self,
                 s: &::dalembert_runtime::taylor::Series<#n>,

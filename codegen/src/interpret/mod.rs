@@ -207,20 +207,17 @@ impl<const N: usize> Interpreted<N> {
             });
         }
         let (np, nq) = (m.params.len(), m.coordinates.len());
-        let series = d
-            .function(Quantity::Accelerations)
-            .map(|a| {
-                let walls = d
-                    .walls
-                    .iter()
-                    .map(|w| {
-                        w.function(Quantity::Surface)
-                            .map(|f| f.program.taylor(np, nq))
-                    })
-                    .collect::<Option<Vec<_>>>()?;
-                Some((a.program.taylor(np, nq), walls))
-            })
-            .flatten();
+        let series = d.function(Quantity::Accelerations).and_then(|a| {
+            let walls = d
+                .walls
+                .iter()
+                .map(|w| {
+                    w.function(Quantity::Surface)
+                        .map(|f| f.program.taylor(np, nq))
+                })
+                .collect::<Option<Vec<_>>>()?;
+            Some((a.program.taylor(np, nq), walls))
+        });
         Ok(Self {
             series,
             name: leak_names(std::iter::once(m.name.clone()))[0],

@@ -108,10 +108,10 @@ impl Writer {
             let pairs: Vec<(Value, Value)> = (0..j).map(|k| (l[j][k], w[k])).collect();
             let pivot = self.minus_products(s(j, j), &pairs)?;
             let r = self.reciprocal(pivot);
-            for i in j + 1..m {
-                let pairs: Vec<(Value, Value)> = (0..j).map(|k| (l[i][k], w[k])).collect();
+            for (i, li) in l.iter_mut().enumerate().take(m).skip(j + 1) {
+                let pairs: Vec<(Value, Value)> = (0..j).map(|k| (li[k], w[k])).collect();
                 let x = self.minus_products(s(i, j), &pairs);
-                l[i][j] = self.product(&[x, Some(r)]);
+                li[j] = self.product(&[x, Some(r)]);
             }
             d.push(pivot);
             inv.push(r);
@@ -303,6 +303,7 @@ impl Program {
 }
 
 #[cfg(test)]
+#[allow(clippy::needless_range_loop)] // matrices by index, as written on paper
 mod tests {
     use super::*;
 

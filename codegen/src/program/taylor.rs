@@ -446,11 +446,11 @@ impl Transform {
             v: vec![[0.0; tay::CAPACITY]; v.len()],
             temps: vec![[0.0; tay::CAPACITY]; self.temps],
         };
-        for i in 0..q.len() {
-            e.q[i][0] = q[i];
+        for (c, x) in e.q.iter_mut().zip(q) {
+            c[0] = *x;
         }
-        for i in 0..v.len() {
-            e.v[i][0] = v[i];
+        for (c, x) in e.v.iter_mut().zip(v) {
+            c[0] = *x;
         }
         let order = order.min(tay::MAX_ORDER);
         for k in 0..order {

@@ -55,7 +55,8 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         }
         let left = (t_end - t0) - self.t_low;
         let h = method.step(&s).min(left);
-        if !(h > 0.0) {
+        // NaN fails too.
+        if h.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
             return Err(SimError::StepTooSmall { t: t0, step: h });
         }
         let mut best: Option<(usize, f64)> = None;
