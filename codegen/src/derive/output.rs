@@ -4,7 +4,7 @@
 //! come from the same expressions.
 
 use crate::ir::Model;
-use crate::program::Program;
+use crate::program::{Program, Transform};
 use crate::quantity::Quantity;
 
 /// Everything derived for one model.
@@ -146,6 +146,26 @@ impl WallDerivation {
 }
 
 impl Derivation {
+    /// The Taylor transforms of q̈ and of each wall's f, which both back
+    /// ends turn into the model's series (`None` where q̈ is not written
+    /// out).
+    pub fn series(&self) -> Option<(Transform, Vec<Transform>)> {
+        let (np, nq) = (self.model.params.len(), self.model.coordinates.len());
+        let motion = self
+            .function(Quantity::Accelerations)?
+            .program
+            .taylor(np, nq);
+        let walls = self
+            .walls
+            .iter()
+            .map(|w| {
+                w.function(Quantity::Surface)
+                    .map(|f| f.program.taylor(np, nq))
+            })
+            .collect::<Option<Vec<_>>>()?;
+        Some((motion, walls))
+    }
+
     /// The model's function for `q`, if it has one.
     pub fn function(&self, q: Quantity) -> Option<&Function> {
         self.functions.iter().find(|f| f.quantity == q)

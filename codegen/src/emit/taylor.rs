@@ -11,25 +11,14 @@ use quote::{format_ident, quote};
 use super::Ctx;
 use super::body::{self, Place};
 use crate::program::{Emit, Op, Program, Series, Slot, Term, Transform};
-use crate::quantity::Quantity;
 
-/// The model's transforms: q̈'s, then each wall's f's (`None` where q̈ has
-/// no closed form: then the model has no series at all).
+/// The model's transforms: q̈'s, then each wall's f's (`None` for f32 or
+/// where q̈ is not written out: then the model has no series at all).
 pub(super) fn transforms(d: &Ctx) -> Option<(Transform, Vec<Transform>)> {
     if d.scalar != super::Scalar::F64 {
         return None;
     }
-    let (np, nq) = (d.model.params.len(), d.model.coordinates.len());
-    let motion = d.function(Quantity::Accelerations)?.program.taylor(np, nq);
-    let walls = d
-        .walls
-        .iter()
-        .map(|w| {
-            w.function(Quantity::Surface)
-                .map(|f| f.program.taylor(np, nq))
-        })
-        .collect::<Option<Vec<_>>>()?;
-    Some((motion, walls))
+    d.series()
 }
 
 /// Series operations per order, and how many of them are convolutions (a

@@ -110,8 +110,8 @@ pub struct Interpreted<const N: usize> {
     forcing: Compiled,
     drift: Compiled,
     accelerations: Option<Compiled>,
-    /// The Taylor transforms of q̈ and of each wall's f, where q̈ is in
-    /// closed form (the generated model's `motion_series` and
+    /// The Taylor transforms of q̈ and of each wall's f, where q̈ is
+    /// written out (the generated model's `motion_series` and
     /// `{wall}_surface_series` do the same operations).
     series: Option<(Transform, Vec<Transform>)>,
     walls: Vec<WallPrograms>,
@@ -206,18 +206,7 @@ impl<const N: usize> Interpreted<N> {
                 collide: find(&w.functions, Quantity::Collide),
             });
         }
-        let (np, nq) = (m.params.len(), m.coordinates.len());
-        let series = d.function(Quantity::Accelerations).and_then(|a| {
-            let walls = d
-                .walls
-                .iter()
-                .map(|w| {
-                    w.function(Quantity::Surface)
-                        .map(|f| f.program.taylor(np, nq))
-                })
-                .collect::<Option<Vec<_>>>()?;
-            Some((a.program.taylor(np, nq), walls))
-        });
+        let series = d.series();
         Ok(Self {
             series,
             name: leak_names(std::iter::once(m.name.clone()))[0],
