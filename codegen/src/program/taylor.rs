@@ -98,7 +98,6 @@ struct Builder<'a> {
     numbers: Program,
     ops: Vec<Op>,
     temps: usize,
-    numbers_written: usize,
     bound: HashMap<Slot, Term>,
     /// sin and cos already taken of a series.
     trig: HashMap<Series, (Series, Series)>,
@@ -118,7 +117,6 @@ impl<'a> Builder<'a> {
             },
             ops: Vec::new(),
             temps: 0,
-            numbers_written: 0,
             bound: HashMap::new(),
             trig: HashMap::new(),
             params,
@@ -166,8 +164,8 @@ impl<'a> Builder<'a> {
 
     /// A number computed by `make(dst)`.
     fn number(&mut self, make: impl FnOnce(Slot) -> Instr) -> Term {
-        let dst = Slot::Temp(self.numbers_written);
-        self.numbers_written += 1;
+        // Instruction j of the numbers writes temporary j.
+        let dst = Slot::Temp(self.numbers.instrs.len());
         self.numbers.instrs.push(make(dst));
         Term::Number(dst)
     }
@@ -353,16 +351,9 @@ impl Transform {
         let mut inputs = vec![0.0; self.numbers.inputs];
         inputs[..params.len()].copy_from_slice(params);
         let mut p = self.numbers.clone();
-        // The temporaries as outputs, to read them back.
-        let written = p
-            .instrs
-            .iter()
-            .filter_map(|i| match i.dst() {
-                Slot::Temp(k) => Some(k + 1),
-                _ => None,
-            })
-            .max()
-            .unwrap_or(0);
+        // The temporaries as outputs, to read them back (instruction j
+        // writes temporary j).
+        let written = p.instrs.len();
         p.instrs
             .extend((0..written).map(|k| Instr::Assign(Slot::Out(k), Slot::Temp(k))));
         p.outputs = written;
