@@ -9,6 +9,7 @@
 
 use dalembert::for_each_model;
 use dalembert::models::*;
+use dalembert::runtime::dynamics::DynamicsError;
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{Integrator, Settings, SimError, Simulator, State, Taylor};
 use dalembert::runtime::taylor::{CAPACITY, Series, eval};
@@ -346,88 +347,144 @@ fn pendulum_hits_the_wall_where_dormand_prince_does() {
     }
 }
 
-/// A model without series (here chain_4 seen only through the traits'
-/// required methods, as a hand-written model would be): Taylor's method is
-/// refused with a typed error, not run wrongly.
-#[test]
-fn models_without_series_refuse_taylor() {
-    struct Plain(Chain4);
-    type W = chain_4::Wall;
-    impl Model<4, 4> for Plain {
-        fn name(&self) -> &str {
-            self.0.name()
-        }
-        fn coordinate_names(&self) -> &[&str] {
-            self.0.coordinate_names()
-        }
-        fn velocity_names(&self) -> &[&str] {
-            self.0.velocity_names()
-        }
-        fn parameter_names(&self) -> &[&str] {
-            self.0.parameter_names()
-        }
-        fn parameter(&self, index: usize) -> Option<f64> {
-            self.0.parameter(index)
-        }
-        fn set_parameter(&mut self, index: usize, value: f64) -> bool {
-            self.0.set_parameter(index, value)
-        }
-        fn mass_matrix(&self, q: &[f64; 4]) -> [[f64; 4]; 4] {
-            self.0.mass_matrix(q)
-        }
-        fn kinetic_energy(&self, q: &[f64; 4], v: &[f64; 4]) -> f64 {
-            self.0.kinetic_energy(q, v)
-        }
-        fn constraints(&self, q: &[f64; 4]) -> dalembert::runtime::Rows<4> {
-            self.0.constraints(q)
-        }
+/// chain_4 seen through the traits' required methods, as a hand-written
+/// model would be, with the series its [`Offered`] says.
+struct Plain(Chain4, Offered);
+
+/// What [`Plain`] offers Taylor's method.
+#[derive(Clone, Copy, PartialEq)]
+enum Offered {
+    /// No series (the traits' defaults).
+    Nothing,
+    /// chain_4's series, with a NaN in one velocity's coefficient of order 7.
+    Poisoned,
+}
+
+type W4 = chain_4::Wall;
+
+impl Model<4, 4> for Plain {
+    fn name(&self) -> &str {
+        self.0.name()
     }
-    impl Walls<4, 4> for Plain {
-        type Wall = W;
-        fn walls(&self) -> &[W] {
-            self.0.walls()
-        }
-        fn wall_name(&self, wall: W) -> &str {
-            self.0.wall_name(wall)
-        }
-        fn wall_rows(&self, wall: W, q: &[f64; 4]) -> dalembert::runtime::Rows<4> {
-            self.0.wall_rows(wall, q)
-        }
-        fn projector(&self, wall: W, q: &[f64; 4]) -> [[f64; 4]; 4] {
-            self.0.projector(wall, q)
-        }
-        fn collide(&self, wall: W, q: &[f64; 4], v: &[f64; 4]) -> [f64; 4] {
-            self.0.collide(wall, q, v)
-        }
+    fn coordinate_names(&self) -> &[&str] {
+        self.0.coordinate_names()
     }
-    impl Dynamics<4> for Plain {
-        fn potential(&self, q: &[f64; 4]) -> f64 {
-            self.0.potential(q)
-        }
-        fn forcing(&self, q: &[f64; 4], v: &[f64; 4]) -> [f64; 4] {
-            self.0.forcing(q, v)
-        }
-        fn constraint_drift(&self, q: &[f64; 4], v: &[f64; 4]) -> [f64; 4] {
-            self.0.constraint_drift(q, v)
-        }
+    fn velocity_names(&self) -> &[&str] {
+        self.0.velocity_names()
     }
-    impl Surfaces<4> for Plain {
-        fn surface(&self, wall: W, q: &[f64; 4]) -> f64 {
-            self.0.surface(wall, q)
-        }
+    fn parameter_names(&self) -> &[&str] {
+        self.0.parameter_names()
     }
-    let chain = Chain4::default();
-    let start = State {
+    fn parameter(&self, index: usize) -> Option<f64> {
+        self.0.parameter(index)
+    }
+    fn set_parameter(&mut self, index: usize, value: f64) -> bool {
+        self.0.set_parameter(index, value)
+    }
+    fn mass_matrix(&self, q: &[f64; 4]) -> [[f64; 4]; 4] {
+        self.0.mass_matrix(q)
+    }
+    fn kinetic_energy(&self, q: &[f64; 4], v: &[f64; 4]) -> f64 {
+        self.0.kinetic_energy(q, v)
+    }
+    fn constraints(&self, q: &[f64; 4]) -> dalembert::runtime::Rows<4> {
+        self.0.constraints(q)
+    }
+}
+impl Walls<4, 4> for Plain {
+    type Wall = W4;
+    fn walls(&self) -> &[W4] {
+        self.0.walls()
+    }
+    fn wall_name(&self, wall: W4) -> &str {
+        self.0.wall_name(wall)
+    }
+    fn wall_rows(&self, wall: W4, q: &[f64; 4]) -> dalembert::runtime::Rows<4> {
+        self.0.wall_rows(wall, q)
+    }
+    fn projector(&self, wall: W4, q: &[f64; 4]) -> [[f64; 4]; 4] {
+        self.0.projector(wall, q)
+    }
+    fn collide(&self, wall: W4, q: &[f64; 4], v: &[f64; 4]) -> [f64; 4] {
+        self.0.collide(wall, q, v)
+    }
+}
+impl Dynamics<4> for Plain {
+    fn potential(&self, q: &[f64; 4]) -> f64 {
+        self.0.potential(q)
+    }
+    fn forcing(&self, q: &[f64; 4], v: &[f64; 4]) -> [f64; 4] {
+        self.0.forcing(q, v)
+    }
+    fn constraint_drift(&self, q: &[f64; 4], v: &[f64; 4]) -> [f64; 4] {
+        self.0.constraint_drift(q, v)
+    }
+    fn taylor_series(&self, s: &mut Series<4>, order: usize) -> bool {
+        if self.1 == Offered::Nothing {
+            return false;
+        }
+        let done = self.0.taylor_series(s, order);
+        if order >= 7 {
+            s.v[2][7] = f64::NAN;
+        }
+        done
+    }
+}
+impl Surfaces<4> for Plain {
+    fn surface(&self, wall: W4, q: &[f64; 4]) -> f64 {
+        self.0.surface(wall, q)
+    }
+    fn surface_series(
+        &self,
+        wall: W4,
+        s: &Series<4>,
+        out: &mut dalembert::runtime::taylor::Coefficients,
+    ) -> bool {
+        self.1 != Offered::Nothing && self.0.surface_series(wall, s, out)
+    }
+}
+
+fn chain_4_start(chain: &Chain4) -> State<4> {
+    State {
         t: 0.0,
         q: chain.initial_coordinates(),
         v: chain.initial_velocities(),
-    };
+    }
+}
+
+/// A model without series: Taylor's method is refused with a typed error,
+/// not run wrongly.
+#[test]
+fn models_without_series_refuse_taylor() {
+    let chain = Chain4::default();
+    let start = chain_4_start(&chain);
     // The generated model itself has them and runs.
     assert!(Simulator::new(&chain, start, taylor()).is_ok());
     assert!(matches!(
-        Simulator::new(&Plain(chain), start, taylor()),
+        Simulator::new(&Plain(chain, Offered::Nothing), start, taylor()),
         Err(SimError::NoSeries)
     ));
+}
+
+/// A series with a NaN in one coefficient stops the run at the step's
+/// start with the typed error, whatever order the NaN is at (the step
+/// checks the state it evaluates on the polynomial, not each coefficient).
+#[test]
+fn non_finite_series_stop_the_run() {
+    let chain = Chain4::default();
+    let model = Plain(chain, Offered::Poisoned);
+    let mut sim = Simulator::new(&model, chain_4_start(&chain), taylor()).unwrap();
+    let err = sim.run(10.0, |_| true).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            SimError::Dynamics {
+                t: 0.0,
+                error: DynamicsError::NonFinite
+            }
+        ),
+        "{err:?}"
+    );
 }
 
 /// The §3.1 ball rolling into the wall, in Euler angles and with a unit

@@ -92,57 +92,131 @@ pub fn eval_with_derivative(c: &Coefficients, order: usize, tau: f64) -> (f64, f
     (p, dp)
 }
 
-/// Σᵢ xᵢ·y₍ₙ₋₁₋ᵢ₎ over n = min(|x|, |y|), in four independent partial
-/// sums: the convolutions below are short dot products whose cost is the
-/// latency of one long chain of additions, and four chains run side by
-/// side.
+// Every recurrence at order k ≥ 1 is split in two: a *history*, a sum over
+// j = 1..k−1 of products of coefficients below k, and a *finish* that adds
+// the terms with coefficient k of an operand and applies the recurrence's
+// factor. Generated code computes the histories of all of a program's
+// operations in one loop over j (independent sums side by side, which is
+// where the time goes) and then finishes each operation in program order;
+// the whole-coefficient functions below ([`mul`], [`sin_cos`], …) compute
+// the same history one term at a time, in the same order, then the same
+// finish, so both give the same bits. The weighted recurrences (eᵃ, ln,
+// sin/cos) multiply by j·aⱼ, which generated code keeps as a series of its
+// own (`j as f64 * a[j]`, the same product).
+
+/// Σⱼ₌₁..ₖ₋₁ aⱼ bₖ₋ⱼ, summed from j = 1 up: the history of a product.
 #[inline(always)]
-fn reversed_dot(x: &[f64], y: &[f64]) -> f64 {
-    let n = x.len().min(y.len());
-    let (x, y) = (&x[..n], &y[..n]);
-    let mut s = [0.0; 4];
-    let mut i = 0;
-    while i + 4 <= n {
-        s[0] += x[i] * y[n - 1 - i];
-        s[1] += x[i + 1] * y[n - 2 - i];
-        s[2] += x[i + 2] * y[n - 3 - i];
-        s[3] += x[i + 3] * y[n - 4 - i];
-        i += 4;
+pub fn history(a: &Coefficients, b: &Coefficients, k: usize) -> f64 {
+    let mut h = 0.0;
+    for j in 1..k {
+        h += a[j] * b[k - j];
     }
-    while i < n {
-        s[0] += x[i] * y[n - 1 - i];
-        i += 1;
-    }
-    (s[0] + s[1]) + (s[2] + s[3])
+    h
 }
 
-/// j·aⱼ for j = 1..=k, at index j − 1: the derivative's coefficients
-/// (times k), which sin, cos and exp convolve with.
+/// Σⱼ₌₁..ₖ₋₁ (j·aⱼ) bₖ₋ⱼ, summed from j = 1 up: the history of eᵃ, ln and
+/// sin/cos, with the weight on `a`.
 #[inline(always)]
-fn scaled(a: &Coefficients, k: usize) -> Coefficients {
-    let mut d = [0.0; CAPACITY];
-    for (j, (dj, aj)) in d.iter_mut().zip(&a[1..=k]).enumerate() {
-        *dj = (j + 1) as f64 * aj;
+pub fn weighted_history(a: &Coefficients, b: &Coefficients, k: usize) -> f64 {
+    let mut h = 0.0;
+    for j in 1..k {
+        h += (j as f64 * a[j]) * b[k - j];
     }
-    d
+    h
+}
+
+/// Σⱼ₌₁..ₖ₋₁ (α(k−j) − j) aₖ₋ⱼ cⱼ, summed from j = 1 up: the history of
+/// c = a^α.
+#[inline(always)]
+pub fn power_history(c: &Coefficients, a: &Coefficients, alpha: f64, k: usize) -> f64 {
+    let mut h = 0.0;
+    for j in 1..k {
+        h += power_weight(alpha, k - j, j) * a[k - j] * c[j];
+    }
+    h
+}
+
+/// The weight α·r − j of aᵣ cⱼ in the recurrence of a^α (r + j = k).
+#[inline(always)]
+pub fn power_weight(alpha: f64, r: usize, j: usize) -> f64 {
+    alpha * r as f64 - j as f64
+}
+
+/// Coefficient k ≥ 1 of a·b from its [`history`] h.
+#[inline(always)]
+pub fn mul_finish(a: &Coefficients, b: &Coefficients, h: f64, k: usize) -> f64 {
+    a[0] * b[k] + a[k] * b[0] + h
+}
+
+/// Coefficient k ≥ 1 of a² from its [`history`] h (of a with itself).
+#[inline(always)]
+pub fn square_finish(a: &Coefficients, h: f64, k: usize) -> f64 {
+    2.0 * a[0] * a[k] + h
+}
+
+/// Coefficient k ≥ 1 of c = 1/a from the [`history`] h of a with c.
+#[inline(always)]
+pub fn recip_finish(c: &Coefficients, a: &Coefficients, h: f64, k: usize) -> f64 {
+    -(a[k] * c[0] + h) * c[0]
+}
+
+/// Coefficient k ≥ 1 of c = √a from the [`history`] h of c with itself.
+#[inline(always)]
+pub fn sqrt_finish(c: &Coefficients, a: &Coefficients, h: f64, k: usize) -> f64 {
+    (a[k] - h) / (2.0 * c[0])
+}
+
+/// Coefficient k ≥ 1 of c = a^α from its [`power_history`] h.
+#[inline(always)]
+pub fn power_finish(c: &Coefficients, a: &Coefficients, alpha: f64, h: f64, k: usize) -> f64 {
+    (power_weight(alpha, k, 0) * a[k] * c[0] + h) / (k as f64 * a[0])
+}
+
+/// Coefficient k ≥ 1 of c = eᵃ from the [`weighted_history`] h of a with c.
+#[inline(always)]
+pub fn exp_finish(c: &Coefficients, a: &Coefficients, h: f64, k: usize) -> f64 {
+    ((k as f64 * a[k]) * c[0] + h) / k as f64
+}
+
+/// Coefficient k ≥ 1 of ln a from the [`weighted_history`] h of ln a with
+/// a.
+#[inline(always)]
+pub fn log_finish(a: &Coefficients, h: f64, k: usize) -> f64 {
+    (a[k] - h / k as f64) / a[0]
+}
+
+/// Coefficient k ≥ 1 of (sin a, cos a) from the [`weighted_history`] of a
+/// with cos (`hs`) and with sin (`hc`).
+#[inline(always)]
+pub fn sin_cos_finish(
+    s: &Coefficients,
+    c: &Coefficients,
+    a: &Coefficients,
+    hs: f64,
+    hc: f64,
+    k: usize,
+) -> (f64, f64) {
+    let kf = k as f64;
+    let dk = kf * a[k];
+    ((dk * c[0] + hs) / kf, -(dk * s[0] + hc) / kf)
 }
 
 /// Coefficient k of a·b.
 #[inline]
 pub fn mul(a: &Coefficients, b: &Coefficients, k: usize) -> f64 {
-    reversed_dot(&a[..=k], &b[..=k])
+    if k == 0 {
+        return a[0] * b[0];
+    }
+    mul_finish(a, b, history(a, b, k), k)
 }
 
-/// Coefficient k of a², from a's coefficients (half the products of
-/// [`mul`]).
+/// Coefficient k of a².
 #[inline]
 pub fn square(a: &Coefficients, k: usize) -> f64 {
-    let half = k.div_ceil(2);
-    let mut acc = 2.0 * reversed_dot(&a[..half], &a[k + 1 - half..=k]);
-    if k.is_multiple_of(2) {
-        acc += a[k / 2] * a[k / 2];
+    if k == 0 {
+        return a[0] * a[0];
     }
-    acc
+    square_finish(a, history(a, a, k), k)
 }
 
 /// Coefficient k of c = 1/a, from a's coefficients and c's below k.
@@ -151,7 +225,7 @@ pub fn recip(c: &Coefficients, a: &Coefficients, k: usize) -> f64 {
     if k == 0 {
         return 1.0 / a[0];
     }
-    -reversed_dot(&a[1..=k], &c[..k]) * c[0]
+    recip_finish(c, a, history(a, c, k), k)
 }
 
 /// Coefficient k of c = √a, from a's coefficients and c's below k.
@@ -160,12 +234,7 @@ pub fn sqrt(c: &Coefficients, a: &Coefficients, k: usize) -> f64 {
     if k == 0 {
         return libm::sqrt(a[0]);
     }
-    let acc = if k > 1 {
-        reversed_dot(&c[1..k], &c[1..k])
-    } else {
-        0.0
-    };
-    (a[k] - acc) / (2.0 * c[0])
+    sqrt_finish(c, a, history(c, c, k), k)
 }
 
 /// Coefficient k of c = a^α (α real), from a's coefficients and c's below
@@ -175,11 +244,7 @@ pub fn power(c: &Coefficients, a: &Coefficients, alpha: f64, k: usize) -> f64 {
     if k == 0 {
         return libm::pow(a[0], alpha);
     }
-    let mut acc = 0.0;
-    for j in 0..k {
-        acc += (alpha * (k - j) as f64 - j as f64) * a[k - j] * c[j];
-    }
-    acc / (k as f64 * a[0])
+    power_finish(c, a, alpha, power_history(c, a, alpha, k), k)
 }
 
 /// Coefficient k of c = exp(a), from a's coefficients and c's below k.
@@ -188,7 +253,7 @@ pub fn exp(c: &Coefficients, a: &Coefficients, k: usize) -> f64 {
     if k == 0 {
         return libm::exp(a[0]);
     }
-    reversed_dot(&scaled(a, k)[..k], &c[..k]) / k as f64
+    exp_finish(c, a, weighted_history(a, c, k), k)
 }
 
 /// Coefficient k of c = ln(a), from a's coefficients and c's below k.
@@ -197,12 +262,7 @@ pub fn log(c: &Coefficients, a: &Coefficients, k: usize) -> f64 {
     if k == 0 {
         return libm::log(a[0]);
     }
-    let acc = if k > 1 {
-        reversed_dot(&scaled(c, k - 1)[..k - 1], &a[1..k])
-    } else {
-        0.0
-    };
-    (a[k] - acc / k as f64) / a[0]
+    log_finish(a, weighted_history(c, a, k), k)
 }
 
 /// Coefficient k of (sin a, cos a), from a's coefficients and those of both
@@ -212,11 +272,14 @@ pub fn sin_cos(s: &Coefficients, c: &Coefficients, a: &Coefficients, k: usize) -
     if k == 0 {
         return libm::sincos(a[0]);
     }
-    let kf = k as f64;
-    let d = scaled(a, k);
-    let ss = reversed_dot(&d[..k], &c[..k]);
-    let cc = reversed_dot(&d[..k], &s[..k]);
-    (ss / kf, -cc / kf)
+    sin_cos_finish(
+        s,
+        c,
+        a,
+        weighted_history(a, c, k),
+        weighted_history(a, s, k),
+        k,
+    )
 }
 
 /// The degree of the polynomial of `order` with coefficients `c`: the

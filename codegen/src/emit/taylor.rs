@@ -2,8 +2,11 @@
 //! series of the motion (`motion_series`) and, per wall, of f along it
 //! (`{wall}_surface_series`), each the Taylor transform
 //! ([`crate::program::Transform`]) of a program the table already holds,
-//! written out as one loop over the orders with one statement per
-//! recurrence. f64 only (the runtime's series are f64).
+//! written out as one loop over the orders. Order 0 is the program on the
+//! values; at each order k ≥ 1 one inner loop over j = 1..k−1 sums every
+//! convolution's history side by side, then each operation is finished in
+//! program order (`dalembert_runtime::taylor`'s `*_finish`). f64 only (the
+//! runtime's series are f64).
 
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
@@ -32,6 +35,10 @@ pub(super) fn counts(t: &Transform) -> (usize, usize) {
     (t.ops.len(), loops)
 }
 
+/// Histories summed side by side in one loop over j: x86-64 has 16
+/// vector registers, and each sum holds one while two operands are loaded.
+const HISTORIES_PER_LOOP: usize = 12;
+
 /// `motion_series` and every `{wall}_surface_series`.
 pub(super) fn functions(d: &Ctx) -> TokenStream {
     let Some((motion, walls)) = transforms(d) else {
@@ -44,8 +51,8 @@ pub(super) fn functions(d: &Ctx) -> TokenStream {
         let i_lit = Literal::usize_unsuffixed(i);
         let out = output(d, &motion, i);
         quote! {
-            s.q[#i_lit][k + 1] = s.v[#i_lit][k] / kf;
-            s.v[#i_lit][k + 1] = #out / kf;
+            s.q[#i_lit][k + 1] = s.v[#i_lit][k] * ik;
+            s.v[#i_lit][k + 1] = #out * ik;
         }
     });
     let motion_fn = quote! {
@@ -59,7 +66,7 @@ pub(super) fn functions(d: &Ctx) -> TokenStream {
             #motion_prelude
             for k in 0..order {
                 #motion_ops
-                let kf = (k + 1) as f64;
+                let ik = 1.0 / (k + 1) as f64;
                 #(#feedback)*
             }
             s.order = order;
@@ -119,7 +126,17 @@ fn prelude(d: &Ctx, t: &Transform) -> TokenStream {
         let x = format_ident!("x{j}");
         quote! { let mut #x: ::dalembert_runtime::taylor::Coefficients = [0.0; ::dalembert_runtime::taylor::CAPACITY]; }
     });
-    quote! { #(#params)* #numbers #(#temps)* }
+    let weights = t.ops.iter().enumerate().filter(|(_, op)| weighted(op)).map(|(j, _)| {
+        let w = format_ident!("w{j}");
+        quote! { let mut #w: ::dalembert_runtime::taylor::Coefficients = [0.0; ::dalembert_runtime::taylor::CAPACITY]; }
+    });
+    quote! { #(#params)* #numbers #(#temps)* #(#weights)* }
+}
+
+/// Whether an op's history is weighted by j (it keeps the series j·xⱼ of
+/// the weighted operand, `w{op}`).
+fn weighted(op: &Op) -> bool {
+    matches!(op, Op::Exp { .. } | Op::Log { .. } | Op::SinCos { .. })
 }
 
 /// A series as an expression (`s.q[i]`, `s.v[i]`, `x{j}`).
@@ -159,62 +176,171 @@ fn output(d: &Ctx, t: &Transform, o: usize) -> TokenStream {
     }
 }
 
-/// Order k of every op.
+/// Order k of every op: at k = 0 the values (the runtime's recurrences at
+/// order 0), beyond it the fused history loop and each op's finish.
 fn ops(d: &Ctx, t: &Transform) -> TokenStream {
     let tay = quote! { ::dalembert_runtime::taylor };
     let p = &t.numbers;
-    let stmts = t.ops.iter().map(|op| match op {
-        Op::Add {
-            dst,
-            series: terms,
-            numbers,
-        } => {
-            let dst = series(*dst);
-            let terms = terms.iter().map(|s| {
-                let s = series(*s);
-                quote! { #s[k] }
-            });
-            let constant = (!numbers.is_empty()).then(|| {
-                let ns = numbers.iter().map(|s| number(d, p, *s));
-                quote! { if k == 0 { #dst[0] += #(#ns)+*; } }
-            });
-            quote! { #dst[k] = #(#terms)+*; #constant }
-        }
-        Op::Scale { dst, a, by } => {
-            let (dst, a) = (series(*dst), series(*a));
-            if matches!(by, Slot::Const(i) if p.consts[*i] == -1.0) {
-                quote! { #dst[k] = -#a[k]; }
-            } else {
-                let by = number(d, p, *by);
-                quote! { #dst[k] = #a[k] * #by; }
+    let linear = |op: &Op, at_zero: bool| -> Option<TokenStream> {
+        match op {
+            Op::Add {
+                dst,
+                series: terms,
+                numbers,
+            } => {
+                let dst = series(*dst);
+                let terms = terms.iter().map(|s| {
+                    let s = series(*s);
+                    quote! { #s[k] }
+                });
+                let constant = (at_zero && !numbers.is_empty()).then(|| {
+                    let ns = numbers.iter().map(|s| number(d, p, *s));
+                    quote! { #dst[0] += #(#ns)+*; }
+                });
+                Some(quote! { #dst[k] = #(#terms)+*; #constant })
             }
+            Op::Scale { dst, a, by } => {
+                let (dst, a) = (series(*dst), series(*a));
+                Some(if matches!(by, Slot::Const(i) if p.consts[*i] == -1.0) {
+                    quote! { #dst[k] = -#a[k]; }
+                } else {
+                    let by = number(d, p, *by);
+                    quote! { #dst[k] = #a[k] * #by; }
+                })
+            }
+            _ => None,
         }
-        Op::Mul { dst, a, b } => {
-            let (dst, a, b) = (series(*dst), series(*a), series(*b));
-            quote! { #dst[k] = #tay::mul(&#a, &#b, k); }
+    };
+    // Order 0: each function's value.
+    let zero = t.ops.iter().map(|op| {
+        if let Some(l) = linear(op, true) {
+            return l;
         }
-        Op::Square { dst, a } => {
-            let (dst, a) = (series(*dst), series(*a));
-            quote! { #dst[k] = #tay::square(&#a, k); }
-        }
-        Op::Recip { dst, a } => unary(quote! { #tay::recip }, *dst, *a, None),
-        Op::Sqrt { dst, a } => unary(quote! { #tay::sqrt }, *dst, *a, None),
-        Op::Exp { dst, a } => unary(quote! { #tay::exp }, *dst, *a, None),
-        Op::Log { dst, a } => unary(quote! { #tay::log }, *dst, *a, None),
-        Op::Power { dst, a, alpha } => {
-            let alpha = Literal::f64_suffixed(*alpha);
-            unary(quote! { #tay::power }, *dst, *a, Some(quote! { #alpha, }))
-        }
-        Op::SinCos { sin, cos, a } => {
-            let (s, c, a) = (series(*sin), series(*cos), series(*a));
-            quote! { (#s[k], #c[k]) = #tay::sin_cos(&#s, &#c, &#a, k); }
+        match op {
+            Op::Mul { dst, a, b } => {
+                let (dst, a, b) = (series(*dst), series(*a), series(*b));
+                quote! { #dst[0] = #tay::mul(&#a, &#b, 0); }
+            }
+            Op::Square { dst, a } => {
+                let (dst, a) = (series(*dst), series(*a));
+                quote! { #dst[0] = #tay::square(&#a, 0); }
+            }
+            Op::Recip { dst, a } => unary(quote! { #tay::recip }, *dst, *a, None),
+            Op::Sqrt { dst, a } => unary(quote! { #tay::sqrt }, *dst, *a, None),
+            Op::Exp { dst, a } => unary(quote! { #tay::exp }, *dst, *a, None),
+            Op::Log { dst, a } => unary(quote! { #tay::log }, *dst, *a, None),
+            Op::Power { dst, a, alpha } => {
+                let alpha = Literal::f64_suffixed(*alpha);
+                unary(quote! { #tay::power }, *dst, *a, Some(quote! { #alpha, }))
+            }
+            Op::SinCos { sin, cos, a } => {
+                let (s, c, a) = (series(*sin), series(*cos), series(*a));
+                quote! { (#s[0], #c[0]) = #tay::sin_cos(&#s, &#c, &#a, 0); }
+            }
+            Op::Add { .. } | Op::Scale { .. } => unreachable!("linear ops above"),
         }
     });
-    quote! { #(#stmts)* }
+    // Orders k ≥ 1: the histories (one accumulator each), then the finishes.
+    let mut accs = Vec::new();
+    let mut terms = Vec::new();
+    let mut history = |term: TokenStream| {
+        let h = format_ident!("h{}", accs.len());
+        terms.push(quote! { #h += #term; });
+        accs.push(h.clone());
+        h
+    };
+    let finishes: Vec<TokenStream> = t
+        .ops
+        .iter()
+        .enumerate()
+        .map(|(j, op)| {
+            if let Some(l) = linear(op, false) {
+                return l;
+            }
+            let w = format_ident!("w{j}");
+            match op {
+                Op::Mul { dst, a, b } => {
+                    let (dst, a, b) = (series(*dst), series(*a), series(*b));
+                    let h = history(quote! { #a[j] * #b[r] });
+                    quote! { #dst[k] = #tay::mul_finish(&#a, &#b, #h, k); }
+                }
+                Op::Square { dst, a } => {
+                    let (dst, a) = (series(*dst), series(*a));
+                    let h = history(quote! { #a[j] * #a[r] });
+                    quote! { #dst[k] = #tay::square_finish(&#a, #h, k); }
+                }
+                Op::Recip { dst, a } => {
+                    let (dst, a) = (series(*dst), series(*a));
+                    let h = history(quote! { #a[j] * #dst[r] });
+                    quote! { #dst[k] = #tay::recip_finish(&#dst, &#a, #h, k); }
+                }
+                Op::Sqrt { dst, a } => {
+                    let (dst, a) = (series(*dst), series(*a));
+                    let h = history(quote! { #dst[j] * #dst[r] });
+                    quote! { #dst[k] = #tay::sqrt_finish(&#dst, &#a, #h, k); }
+                }
+                Op::Power { dst, a, alpha } => {
+                    let (dst, a) = (series(*dst), series(*a));
+                    let alpha = Literal::f64_suffixed(*alpha);
+                    let h = history(quote! { #tay::power_weight(#alpha, r, j) * #a[r] * #dst[j] });
+                    quote! { #dst[k] = #tay::power_finish(&#dst, &#a, #alpha, #h, k); }
+                }
+                Op::Exp { dst, a } => {
+                    let (dst, a) = (series(*dst), series(*a));
+                    let h = history(quote! { #w[j] * #dst[r] });
+                    quote! {
+                        #w[k] = k as f64 * #a[k];
+                        #dst[k] = #tay::exp_finish(&#dst, &#a, #h, k);
+                    }
+                }
+                Op::Log { dst, a } => {
+                    let (dst, a) = (series(*dst), series(*a));
+                    let h = history(quote! { #w[j] * #a[r] });
+                    quote! {
+                        #dst[k] = #tay::log_finish(&#a, #h, k);
+                        #w[k] = k as f64 * #dst[k];
+                    }
+                }
+                Op::SinCos { sin, cos, a } => {
+                    let (s, c, a) = (series(*sin), series(*cos), series(*a));
+                    let hs = history(quote! { #w[j] * #c[r] });
+                    let hc = history(quote! { #w[j] * #s[r] });
+                    quote! {
+                        #w[k] = k as f64 * #a[k];
+                        (#s[k], #c[k]) = #tay::sin_cos_finish(&#s, &#c, &#a, #hs, #hc, k);
+                    }
+                }
+                Op::Add { .. } | Op::Scale { .. } => unreachable!("linear ops above"),
+            }
+        })
+        .collect();
+    // One loop per group of histories: enough independent sums to keep the
+    // floating-point units busy, few enough that they stay in registers.
+    let fused = accs
+        .chunks(HISTORIES_PER_LOOP)
+        .zip(terms.chunks(HISTORIES_PER_LOOP))
+        .map(|(accs, terms)| {
+            quote! {
+                #(let mut #accs = 0.0;)*
+                for j in 1..k {
+                    let r = k - j;
+                    #(#terms)*
+                }
+            }
+        });
+    quote! {
+        if k == 0 {
+            #(#zero)*
+        } else {
+            #(#fused)*
+            #(#finishes)*
+        }
+    }
 }
 
-/// dst[k] = f(&dst, &a, [extra,] k): a recurrence on its own result.
+/// dst[0] = f(&dst, &a, [extra,] 0): a recurrence on its own result, at
+/// order 0.
 fn unary(f: TokenStream, dst: Series, a: Series, extra: Option<TokenStream>) -> TokenStream {
     let (dst, a) = (series(dst), series(a));
-    quote! { #dst[k] = #f(&#dst, &#a, #extra k); }
+    quote! { #dst[0] = #f(&#dst, &#a, #extra 0); }
 }

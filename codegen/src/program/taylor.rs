@@ -446,10 +446,10 @@ impl Transform {
         let order = order.min(tay::MAX_ORDER);
         for k in 0..order {
             self.order(&mut e, numbers, k);
-            let kf = (k + 1) as f64;
+            let ik = 1.0 / (k + 1) as f64;
             for i in 0..v.len() {
-                e.q[i][k + 1] = e.v[i][k] / kf;
-                e.v[i][k + 1] = self.output(&e, numbers, i, k) / kf;
+                e.q[i][k + 1] = e.v[i][k] * ik;
+                e.v[i][k + 1] = self.output(&e, numbers, i, k) * ik;
             }
         }
         e

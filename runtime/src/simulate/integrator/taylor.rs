@@ -57,17 +57,21 @@ impl Taylor {
             m
         };
         let scale = norm(0).max(1.0);
-        let radius = |j: usize| {
+        // In logarithms: ln h = ln ρ − 2 − 0.7/(p − 1), two logarithms and
+        // one exponential per step.
+        let log_radius = |j: usize| {
             let x = norm(j);
             if x == 0.0 {
                 f64::INFINITY
             } else {
-                libm::pow(scale / x, 1.0 / j as f64)
+                libm::log(scale / x) / j as f64
             }
         };
-        let rho = radius(p - 1).min(radius(p));
-        let e2 = core::f64::consts::E * core::f64::consts::E;
-        (rho / e2 * libm::exp(-0.7 / (p - 1) as f64)).min(self.max_step)
+        let log_rho = log_radius(p - 1).min(log_radius(p));
+        if log_rho == f64::INFINITY {
+            return self.max_step;
+        }
+        libm::exp(log_rho - 2.0 - 0.7 / (p - 1) as f64).min(self.max_step)
     }
 }
 
