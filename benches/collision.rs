@@ -34,77 +34,9 @@ use nalgebra::{DMatrix, DVector};
 mod cpu_time;
 use cpu_time::ThreadCpuTime;
 
-/// Theorem 3.1 for admissible v = (v1, v2, w1, w2, w3), with w1, w2 of v⁺ from
-/// the rolling constraints (3.1), recomputing the parameter combinations.
-fn hand_3_1(m: f64, r: f64, j: f64, v: &[f64; 5]) -> [f64; 5] {
-    Hand31::new(m, r, j).collide(v)
-}
-
-/// Theorem 3.1 with the parameter combinations computed once.
-struct Hand31 {
-    a: f64,
-    b: f64,
-    c: f64,
-    r: f64,
-}
-
-impl Hand31 {
-    fn new(m: f64, r: f64, j: f64) -> Self {
-        let jt = j + 0.5 * r * r * m; // J~
-        let jp = j + r * r * m; // J'
-        let inv = 1.0 / jt;
-        Self {
-            a: 0.5 * r * r * m * inv,
-            b: r * j * inv,
-            c: jp * inv / r,
-            r,
-        }
-    }
-
-    #[inline]
-    fn collide(&self, v: &[f64; 5]) -> [f64; 5] {
-        let v1 = -v[0];
-        let v2 = self.a * v[1] + self.b * v[4];
-        let w3 = self.c * v[1] - self.a * v[4];
-        [v1, v2, -v2 / self.r, v1 / self.r, w3]
-    }
-}
-
-/// Theorem 3.2, recomputing the parameter combinations.
-fn hand_3_2(m: f64, r: f64, j: f64, v: &[f64; 6]) -> [f64; 6] {
-    Hand32::new(m, r, j).collide(v)
-}
-
-/// Theorem 3.2 with the parameter combinations computed once.
-struct Hand32 {
-    a: f64,
-    b: f64,
-    c: f64,
-}
-
-impl Hand32 {
-    fn new(m: f64, r: f64, j: f64) -> Self {
-        let inv = 1.0 / (j + r * r * m); // 1/J'
-        Self {
-            a: (m * r * r - j) * inv,
-            b: 2.0 * j * r * inv,
-            c: 2.0 * r * m * inv,
-        }
-    }
-
-    #[inline]
-    fn collide(&self, v: &[f64; 6]) -> [f64; 6] {
-        let (a, b, c) = (self.a, self.b, self.c);
-        [
-            a * v[0] + b * v[4],
-            a * v[1] - b * v[3],
-            -v[2],
-            -c * v[1] - a * v[3],
-            c * v[0] - a * v[4],
-            v[5],
-        ]
-    }
-}
+#[path = "common/hand.rs"]
+mod hand;
+use hand::{Hand31, Hand32, hand_3_1, hand_3_2};
 
 /// P from G and B with dynamic matrices, then (I − 2P)v.
 fn generic_dynamic(g: &DMatrix<f64>, b: &DMatrix<f64>, v: &DVector<f64>) -> DVector<f64> {
@@ -126,39 +58,9 @@ fn dynamic_inputs<M: Walls<0, N>, const N: usize>(
     (gd, bd)
 }
 
-/// Inputs cycled through by every path, so that no path is timed on one
-/// value the branch predictor or the compiler could learn.
-const INPUTS: usize = 1024;
-
-/// `INPUTS` velocities from `make` fed uniform numbers in [-2, 2).
-fn inputs<const N: usize>(make: impl Fn([f64; N]) -> [f64; N]) -> Vec<[f64; N]> {
-    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-    let mut uniform = || {
-        state = state
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (state >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0
-    };
-    (0..INPUTS)
-        .map(|_| make(std::array::from_fn(|_| uniform())))
-        .collect()
-}
-
-/// Times `f` over the inputs in turn.
-fn cycle<const N: usize>(
-    g: &mut BenchmarkGroup<'_, ThreadCpuTime>,
-    name: &str,
-    vs: &[[f64; N]],
-    f: impl Fn(&[f64; N]) -> [f64; N],
-) {
-    g.bench_function(name, |b| {
-        let mut k = 0;
-        b.iter(|| {
-            k = (k + 1) % INPUTS;
-            f(black_box(&vs[k]))
-        })
-    });
-}
+#[path = "common/inputs.rs"]
+mod inputs;
+use inputs::{cycle, inputs};
 
 /// The paths for one instantaneous model's first wall, after checking that
 /// the generated, hand-written and generic maps agree on every input.

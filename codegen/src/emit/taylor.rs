@@ -126,8 +126,8 @@ fn prelude(d: &Ctx, t: &Transform) -> TokenStream {
         let x = format_ident!("x{j}");
         quote! { let mut #x: ::dalembert_runtime::taylor::Coefficients = [0.0; ::dalembert_runtime::taylor::CAPACITY]; }
     });
-    let weights = t.ops.iter().enumerate().filter(|(_, op)| weighted(op)).map(|(j, _)| {
-        let w = format_ident!("w{j}");
+    let weights = t.ops.iter().enumerate().filter(|(_, op)| weighted(op)).map(|(index, _)| {
+        let w = format_ident!("w{index}");
         quote! { let mut #w: ::dalembert_runtime::taylor::Coefficients = [0.0; ::dalembert_runtime::taylor::CAPACITY]; }
     });
     quote! { #(#params)* #numbers #(#temps)* #(#weights)* }
@@ -176,44 +176,60 @@ fn output(d: &Ctx, t: &Transform, o: usize) -> TokenStream {
     }
 }
 
-/// Order k of every op: at k = 0 the values (the runtime's recurrences at
-/// order 0), beyond it the fused history loop and each op's finish.
+/// Order k of every op: at k = 0 the values, beyond it the fused history
+/// loops and each op's finish.
 fn ops(d: &Ctx, t: &Transform) -> TokenStream {
-    let tay = quote! { ::dalembert_runtime::taylor };
-    let p = &t.numbers;
-    let linear = |op: &Op, at_zero: bool| -> Option<TokenStream> {
-        match op {
-            Op::Add {
-                dst,
-                series: terms,
-                numbers,
-            } => {
-                let dst = series(*dst);
-                let terms = terms.iter().map(|s| {
-                    let s = series(*s);
-                    quote! { #s[k] }
-                });
-                let constant = (at_zero && !numbers.is_empty()).then(|| {
-                    let ns = numbers.iter().map(|s| number(d, p, *s));
-                    quote! { #dst[0] += #(#ns)+*; }
-                });
-                Some(quote! { #dst[k] = #(#terms)+*; #constant })
-            }
-            Op::Scale { dst, a, by } => {
-                let (dst, a) = (series(*dst), series(*a));
-                Some(if matches!(by, Slot::Const(i) if p.consts[*i] == -1.0) {
-                    quote! { #dst[k] = -#a[k]; }
-                } else {
-                    let by = number(d, p, *by);
-                    quote! { #dst[k] = #a[k] * #by; }
-                })
-            }
-            _ => None,
+    let zero = order_zero(d, t);
+    let (histories, finishes) = order_k(d, t);
+    quote! {
+        if k == 0 {
+            #zero
+        } else {
+            #histories
+            #finishes
         }
-    };
-    // Order 0: each function's value.
-    let zero = t.ops.iter().map(|op| {
-        if let Some(l) = linear(op, true) {
+    }
+}
+
+/// Coefficient k of a sum or a scaling (the same at every order but for
+/// the numbers of a sum, which count at order 0 only); `None` for the
+/// other ops.
+fn linear(d: &Ctx, p: &Program, op: &Op, at_zero: bool) -> Option<TokenStream> {
+    match op {
+        Op::Add {
+            dst,
+            series: terms,
+            numbers,
+        } => {
+            let dst = series(*dst);
+            let terms = terms.iter().map(|s| {
+                let s = series(*s);
+                quote! { #s[k] }
+            });
+            let constant = (at_zero && !numbers.is_empty()).then(|| {
+                let ns = numbers.iter().map(|s| number(d, p, *s));
+                quote! { #dst[0] += #(#ns)+*; }
+            });
+            Some(quote! { #dst[k] = #(#terms)+*; #constant })
+        }
+        Op::Scale { dst, a, by } => {
+            let (dst, a) = (series(*dst), series(*a));
+            Some(if matches!(by, Slot::Const(i) if p.consts[*i] == -1.0) {
+                quote! { #dst[k] = -#a[k]; }
+            } else {
+                let by = number(d, p, *by);
+                quote! { #dst[k] = #a[k] * #by; }
+            })
+        }
+        _ => None,
+    }
+}
+
+/// Order 0: each function's value (the runtime's recurrences at order 0).
+fn order_zero(d: &Ctx, t: &Transform) -> TokenStream {
+    let tay = quote! { ::dalembert_runtime::taylor };
+    let stmts = t.ops.iter().map(|op| {
+        if let Some(l) = linear(d, &t.numbers, op, true) {
             return l;
         }
         match op {
@@ -240,7 +256,14 @@ fn ops(d: &Ctx, t: &Transform) -> TokenStream {
             Op::Add { .. } | Op::Scale { .. } => unreachable!("linear ops above"),
         }
     });
-    // Orders k ≥ 1: the histories (one accumulator each), then the finishes.
+    quote! { #(#stmts)* }
+}
+
+/// Orders k ≥ 1: the history loops (one accumulator per history, at most
+/// [`HISTORIES_PER_LOOP`] per loop), then each op's finish in program
+/// order.
+fn order_k(d: &Ctx, t: &Transform) -> (TokenStream, TokenStream) {
+    let tay = quote! { ::dalembert_runtime::taylor };
     let mut accs = Vec::new();
     let mut terms = Vec::new();
     let mut history = |term: TokenStream| {
@@ -253,11 +276,11 @@ fn ops(d: &Ctx, t: &Transform) -> TokenStream {
         .ops
         .iter()
         .enumerate()
-        .map(|(j, op)| {
-            if let Some(l) = linear(op, false) {
+        .map(|(index, op)| {
+            if let Some(l) = linear(d, &t.numbers, op, false) {
                 return l;
             }
-            let w = format_ident!("w{j}");
+            let w = format_ident!("w{index}");
             match op {
                 Op::Mul { dst, a, b } => {
                     let (dst, a, b) = (series(*dst), series(*a), series(*b));
@@ -328,14 +351,7 @@ fn ops(d: &Ctx, t: &Transform) -> TokenStream {
                 }
             }
         });
-    quote! {
-        if k == 0 {
-            #(#zero)*
-        } else {
-            #(#fused)*
-            #(#finishes)*
-        }
-    }
+    (quote! { #(#fused)* }, quote! { #(#finishes)* })
 }
 
 /// dst[0] = f(&dst, &a, [extra,] 0): a recurrence on its own result, at

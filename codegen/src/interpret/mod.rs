@@ -110,12 +110,41 @@ pub struct Interpreted<const N: usize> {
     forcing: Compiled,
     drift: Compiled,
     accelerations: Option<Compiled>,
-    /// The Taylor transforms of q̈ and of each wall's f, where q̈ is
-    /// written out (the generated model's `motion_series` and
-    /// `{wall}_surface_series` do the same operations).
-    series: Option<(Transform, Vec<Transform>)>,
+    /// The Taylor series, where q̈ is written out.
+    series: Option<SeriesPrograms>,
     walls: Vec<WallPrograms>,
     indices: Vec<WallIndex>,
+}
+
+/// The Taylor transforms of q̈ and of each wall's f (the generated model's
+/// `motion_series` and `{wall}_surface_series` do the same operations),
+/// with their time-constant values at the current parameters.
+#[derive(Clone, Debug)]
+struct SeriesPrograms {
+    motion: Transform,
+    walls: Vec<Transform>,
+    /// [`Transform::number_values`] of `motion`, then of each wall.
+    numbers: Vec<Vec<f64>>,
+}
+
+impl SeriesPrograms {
+    fn new((motion, walls): (Transform, Vec<Transform>), params: &[f64]) -> Self {
+        let mut s = Self {
+            motion,
+            walls,
+            numbers: Vec::new(),
+        };
+        s.refresh(params);
+        s
+    }
+
+    /// Recomputes the time-constant values (the parameters changed).
+    fn refresh(&mut self, params: &[f64]) {
+        self.numbers = std::iter::once(&self.motion)
+            .chain(&self.walls)
+            .map(|t| t.number_values(params, run_program))
+            .collect();
+    }
 }
 
 /// Why a derivation cannot be interpreted with `N` coordinates.
@@ -206,7 +235,7 @@ impl<const N: usize> Interpreted<N> {
                 collide: find(&w.functions, Quantity::Collide),
             });
         }
-        let series = d.series();
+        let series = d.series().map(|t| SeriesPrograms::new(t, &values));
         Ok(Self {
             series,
             name: leak_names(std::iter::once(m.name.clone()))[0],
@@ -327,6 +356,9 @@ impl<const N: usize> Model<N, N> for Interpreted<N> {
         for c in self.programs_mut() {
             c.set_parameter(index, value);
         }
+        if let Some(s) = &mut self.series {
+            s.refresh(&self.values);
+        }
         true
     }
     fn mass_matrix(&self, q: &[f64; N]) -> [[f64; N]; N] {
@@ -409,14 +441,13 @@ impl<const N: usize> Dynamics<N> for Interpreted<N> {
         self.accelerations.as_ref().map(|c| self.vector(c, q, v))
     }
     fn taylor_series(&self, series: &mut Series<N>, order: usize) -> bool {
-        let Some((motion, _)) = &self.series else {
+        let Some(sp) = &self.series else {
             return false;
         };
         let q: [f64; N] = std::array::from_fn(|i| series.q[i][0]);
         let v: [f64; N] = std::array::from_fn(|i| series.v[i][0]);
         let order = order.min(MAX_ORDER);
-        let numbers = motion.number_values(&self.values, run_program);
-        let e = motion.motion(&numbers, &q, &v, order);
+        let e = sp.motion.motion(&sp.numbers[0], &q, &v, order);
         for i in 0..N {
             series.q[i] = e.q[i];
             series.v[i] = e.v[i];
@@ -434,7 +465,11 @@ impl<const N: usize> Surfaces<N> for Interpreted<N> {
         Some(self.scalar(&self.wall(wall).surface_hessian, q, v))
     }
     fn surface_series(&self, wall: WallIndex, series: &Series<N>, out: &mut Coefficients) -> bool {
-        let Some(t) = self.series.as_ref().and_then(|(_, w)| w.get(wall.0)) else {
+        let Some((t, numbers)) = self
+            .series
+            .as_ref()
+            .and_then(|s| Some((s.walls.get(wall.0)?, &s.numbers[wall.0 + 1])))
+        else {
             return false;
         };
         let mut e = Evaluation {
@@ -442,8 +477,7 @@ impl<const N: usize> Surfaces<N> for Interpreted<N> {
             v: series.v.to_vec(),
             temps: Vec::new(),
         };
-        let numbers = t.number_values(&self.values, run_program);
-        *out = t.along(&numbers, &mut e, series.order);
+        *out = t.along(numbers, &mut e, series.order);
         true
     }
 }
