@@ -35,6 +35,9 @@ use dalembert::runtime::simulate::{
     DormandPrince, Integrator, Settings, Simulator, State, Stats, Taylor,
 };
 
+#[path = "../tests/common/bounce.rs"]
+mod bounce;
+
 #[path = "common/cpu_time.rs"]
 mod cpu_time;
 use cpu_time::ThreadCpuTime;
@@ -60,14 +63,8 @@ fn methods() -> [(&'static str, Settings); 2] {
 
 /// §3.2.1: just after a bounce at x = 0 with u = 2, v = 1.
 fn bounce_start(ball: &BallBounce) -> State<6> {
-    let p = ball.params();
-    let q = [0.0, 0.0, p.r, 0.0, std::f64::consts::FRAC_PI_2, 0.0];
-    let v_minus = [-1.0, 0.0, -2.0, 0.0, 0.0, -p.r * p.m / p.J];
-    State {
-        t: 0.0,
-        q,
-        v: ball.collide(ball_bounce::Wall::Floor, &q, &v_minus),
-    }
+    let (q, v) = bounce::after_bounce(ball);
+    State { t: 0.0, q, v }
 }
 
 /// Runs `bounces` bounces; returns the stats, the worst relative error of

@@ -8,6 +8,9 @@
 //! than resolved.
 
 use dalembert::models::{BallBounce, BallWallEuler, Chain3, MassesOnLine, PendulumWall};
+
+#[path = "common/bounce.rs"]
+mod bounce;
 use dalembert::runtime::dynamics::DynamicsError;
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
@@ -174,17 +177,9 @@ fn pendulum_bounces_off_the_wall_as_the_textbook_says() {
 #[test]
 fn nonholonomic_pendulum_is_periodic_over_ten_thousand_bounces() {
     let ball = BallBounce::default();
-    let (m, r, j, g) = (
-        ball.params().m,
-        ball.params().r,
-        ball.params().J,
-        ball.params().g,
-    );
-    let (u, v) = (2.0, 1.0);
-    // At φ = ψ = 0, θ = π/2: ω = (θ', −ψ', φ').
-    let q = [0.0, 0.0, r, 0.0, std::f64::consts::FRAC_PI_2, 0.0];
-    let w2 = r * m * v / j;
-    let v_minus = [-v, 0.0, -u, 0.0, 0.0, -w2];
+    let (r, g) = (ball.params().r, ball.params().g);
+    let (u, v) = (bounce::U, bounce::V);
+    let (q, v_minus) = bounce::before_bounce(&ball);
     let v_plus = ball.collide(dalembert::models::ball_bounce::Wall::Floor, &q, &v_minus);
     for i in 0..6 {
         assert!((v_plus[i] + v_minus[i]).abs() < 1e-14, "§3.2.1: v⁺ = −v⁻");

@@ -14,6 +14,8 @@ use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{Integrator, Settings, SimError, Simulator, State, Taylor};
 use dalembert::runtime::taylor::{CAPACITY, Series, eval};
 
+#[path = "common/bounce.rs"]
+mod bounce;
 mod common;
 use common::{for_random_cases, onto_kernel};
 
@@ -220,17 +222,9 @@ fn pendulum_series_is_the_angles() {
 #[test]
 fn nonholonomic_pendulum_with_taylor() {
     let ball = BallBounce::default();
-    let (m, r, j, g) = (
-        ball.params().m,
-        ball.params().r,
-        ball.params().J,
-        ball.params().g,
-    );
-    let (u, v) = (2.0, 1.0);
-    let q = [0.0, 0.0, r, 0.0, std::f64::consts::FRAC_PI_2, 0.0];
-    let w2 = r * m * v / j;
-    let v_minus = [-v, 0.0, -u, 0.0, 0.0, -w2];
-    let v_plus = ball.collide(ball_bounce::Wall::Floor, &q, &v_minus);
+    let (r, g) = (ball.params().r, ball.params().g);
+    let (u, v) = (bounce::U, bounce::V);
+    let (q, v_plus) = bounce::after_bounce(&ball);
     let start = State {
         t: 0.0,
         q,
