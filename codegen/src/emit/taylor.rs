@@ -179,6 +179,17 @@ fn output(d: &Ctx, t: &Transform, o: usize) -> TokenStream {
 /// Order k of every op: at k = 0 the values, beyond it the fused history
 /// loops and each op's finish.
 fn ops(d: &Ctx, t: &Transform) -> TokenStream {
+    if t.ops
+        .iter()
+        .all(|op| linear(d, &t.numbers, op, At::Any).is_some())
+    {
+        // Sums and scalings only: one statement per op at every order.
+        let stmts = t
+            .ops
+            .iter()
+            .flat_map(|op| linear(d, &t.numbers, op, At::Any));
+        return quote! { #(#stmts)* };
+    }
     let zero = order_zero(d, t);
     let (histories, finishes) = order_k(d, t);
     quote! {
@@ -191,10 +202,21 @@ fn ops(d: &Ctx, t: &Transform) -> TokenStream {
     }
 }
 
+/// Which orders a statement is written for.
+#[derive(Clone, Copy, PartialEq)]
+enum At {
+    /// Order 0 only.
+    Zero,
+    /// Orders k ≥ 1 only.
+    Beyond,
+    /// Every order (the order-0 part guarded by `k == 0`).
+    Any,
+}
+
 /// Coefficient k of a sum or a scaling (the same at every order but for
 /// the numbers of a sum, which count at order 0 only); `None` for the
 /// other ops.
-fn linear(d: &Ctx, p: &Program, op: &Op, at_zero: bool) -> Option<TokenStream> {
+fn linear(d: &Ctx, p: &Program, op: &Op, at: At) -> Option<TokenStream> {
     match op {
         Op::Add {
             dst,
@@ -206,9 +228,14 @@ fn linear(d: &Ctx, p: &Program, op: &Op, at_zero: bool) -> Option<TokenStream> {
                 let s = series(*s);
                 quote! { #s[k] }
             });
-            let constant = (at_zero && !numbers.is_empty()).then(|| {
+            let constant = (at != At::Beyond && !numbers.is_empty()).then(|| {
                 let ns = numbers.iter().map(|s| number(d, p, *s));
-                quote! { #dst[0] += #(#ns)+*; }
+                let add = quote! { #dst[0] += #(#ns)+*; };
+                if at == At::Any {
+                    quote! { if k == 0 { #add } }
+                } else {
+                    add
+                }
             });
             Some(quote! { #dst[k] = #(#terms)+*; #constant })
         }
@@ -229,7 +256,7 @@ fn linear(d: &Ctx, p: &Program, op: &Op, at_zero: bool) -> Option<TokenStream> {
 fn order_zero(d: &Ctx, t: &Transform) -> TokenStream {
     let tay = quote! { ::dalembert_runtime::taylor };
     let stmts = t.ops.iter().map(|op| {
-        if let Some(l) = linear(d, &t.numbers, op, true) {
+        if let Some(l) = linear(d, &t.numbers, op, At::Zero) {
             return l;
         }
         match op {
@@ -277,7 +304,7 @@ fn order_k(d: &Ctx, t: &Transform) -> (TokenStream, TokenStream) {
         .iter()
         .enumerate()
         .map(|(index, op)| {
-            if let Some(l) = linear(d, &t.numbers, op, false) {
+            if let Some(l) = linear(d, &t.numbers, op, At::Beyond) {
                 return l;
             }
             let w = format_ident!("w{index}");
