@@ -31,6 +31,29 @@ pub const MAX_ORDER: usize = CAPACITY - 1;
 /// The coefficients of one function of time.
 pub type Coefficients = [f64; CAPACITY];
 
+/// An intermediate series of which generated code only ever reads the
+/// coefficient of the order it is computing (a sum's or a product's result
+/// that no recurrence reads back): it keeps that coefficient alone, and
+/// indexing it at any order gives it. 8 bytes of stack instead of a
+/// [`Coefficients`] array's 256.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Current(pub f64);
+
+impl core::ops::Index<usize> for Current {
+    type Output = f64;
+    #[inline(always)]
+    fn index(&self, _order: usize) -> &f64 {
+        &self.0
+    }
+}
+
+impl core::ops::IndexMut<usize> for Current {
+    #[inline(always)]
+    fn index_mut(&mut self, _order: usize) -> &mut f64 {
+        &mut self.0
+    }
+}
+
 /// The Taylor series of a state (q(t₀ + τ), q̇(t₀ + τ)) in τ: `q[i][k]` is
 /// the k-th normalised coefficient of coordinate i, `v[i][k]` that of
 /// velocity i.

@@ -122,9 +122,15 @@ fn prelude(d: &Ctx, t: &Transform) -> TokenStream {
             let (name, field) = (format_ident!("i{i}"), super::ident(&p.name));
             quote! { let #name: f64 = self.params.#field; }
         });
-    let temps = (0..t.temps).map(|j| {
+    // Temporaries read only at the current order keep that coefficient
+    // alone (`taylor::Current`, indexed like the arrays).
+    let temps = t.current_only().into_iter().enumerate().map(|(j, current)| {
         let x = format_ident!("x{j}");
-        quote! { let mut #x: ::dalembert_runtime::taylor::Coefficients = [0.0; ::dalembert_runtime::taylor::CAPACITY]; }
+        if current {
+            quote! { let mut #x = ::dalembert_runtime::taylor::Current::default(); }
+        } else {
+            quote! { let mut #x: ::dalembert_runtime::taylor::Coefficients = [0.0; ::dalembert_runtime::taylor::CAPACITY]; }
+        }
     });
     let weights = t.ops.iter().enumerate().filter(|(_, op)| weighted(op)).map(|(index, _)| {
         let w = format_ident!("w{index}");

@@ -327,6 +327,45 @@ impl Op {
     }
 }
 
+impl Transform {
+    /// For each temporary, whether only its current coefficient is ever
+    /// read: it is written by a sum, a scaling or a product and read only
+    /// by sums, scalings and the outputs, never by a recurrence (which
+    /// reads an operand's lower coefficients, or its own).
+    pub fn current_only(&self) -> Vec<bool> {
+        let mut only = vec![true; self.temps];
+        let mut keep = |s: &Series| {
+            if let Series::Temp(i) = s {
+                only[*i] = false;
+            }
+        };
+        for op in &self.ops {
+            match op {
+                Op::Add { .. } | Op::Scale { .. } => {}
+                Op::Mul { a, b, .. } => {
+                    keep(a);
+                    keep(b);
+                }
+                Op::Square { a, .. } => keep(a),
+                Op::Recip { dst, a }
+                | Op::Sqrt { dst, a }
+                | Op::Power { dst, a, .. }
+                | Op::Exp { dst, a }
+                | Op::Log { dst, a } => {
+                    keep(dst);
+                    keep(a);
+                }
+                Op::SinCos { sin, cos, a } => {
+                    keep(sin);
+                    keep(cos);
+                    keep(a);
+                }
+            }
+        }
+        only
+    }
+}
+
 /// The series state of an evaluation: coordinates, velocities, temporaries.
 #[derive(Clone, Debug)]
 pub struct Evaluation {
@@ -507,6 +546,10 @@ mod tests {
         let t = p.taylor(2, 1);
         // Only the product with sin q is series work.
         assert_eq!(t.ops.len(), 2, "{:?}", t.ops);
+        // sin and cos q come from a recurrence (each reads the other's
+        // lower coefficients); sin q scaled by −g/l is read by the output
+        // alone.
+        assert_eq!(t.current_only(), vec![false, false, true], "{:?}", t.ops);
         let (gv, lv, q0, v0) = (9.81, 2.0, 0.7, -0.4);
         let numbers = t.number_values(&[gv, lv], |p, x| p.eval(x));
         let e = t.motion(&numbers, &[q0], &[v0], 20);
