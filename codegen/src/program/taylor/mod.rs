@@ -14,9 +14,10 @@
 
 use std::collections::HashMap;
 
-use dalembert_runtime::taylor::{self as tay, Coefficients};
-
 use super::{Func, Instr, Program, Slot, constant};
+
+mod evaluate;
+pub use evaluate::Evaluation;
 
 /// A series the transform reads or writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -366,154 +367,10 @@ impl Transform {
     }
 }
 
-/// The series state of an evaluation: coordinates, velocities, temporaries.
-#[derive(Clone, Debug)]
-pub struct Evaluation {
-    /// Coefficients of each coordinate.
-    pub q: Vec<Coefficients>,
-    /// Coefficients of each velocity.
-    pub v: Vec<Coefficients>,
-    /// Coefficients of each intermediate series.
-    pub temps: Vec<Coefficients>,
-}
-
-impl Transform {
-    /// The time-constant values at the parameters `params`: a vector that
-    /// [`Term::Number`] slots index by [`Transform::number_index`]. `eval`
-    /// runs a program on its inputs (the interpreter passes its tape, which
-    /// computes as emitted code does; [`Program::eval`] serves tests).
-    pub fn number_values(
-        &self,
-        params: &[f64],
-        eval: impl FnOnce(&Program, &[f64]) -> Vec<f64>,
-    ) -> Vec<f64> {
-        let mut inputs = vec![0.0; self.numbers.inputs];
-        inputs[..params.len()].copy_from_slice(params);
-        let mut p = self.numbers.clone();
-        // The temporaries as outputs, to read them back (instruction j
-        // writes temporary j).
-        let written = p.instrs.len();
-        p.instrs
-            .extend((0..written).map(|k| Instr::Assign(Slot::Out(k), Slot::Temp(k))));
-        p.outputs = written;
-        let temps = eval(&p, &inputs);
-        let mut all = inputs;
-        all.extend(&self.numbers.consts);
-        all.extend(temps);
-        all
-    }
-
-    /// Where a number slot's value is in [`Transform::number_values`].
-    pub fn number_index(&self, s: Slot) -> usize {
-        match s {
-            Slot::Input(i) => i,
-            Slot::Const(i) => self.numbers.inputs + i,
-            Slot::Temp(i) | Slot::Out(i) => self.numbers.inputs + self.numbers.consts.len() + i,
-        }
-    }
-
-    /// Runs order k of every op on `e` (coefficients below k in place).
-    pub fn order(&self, e: &mut Evaluation, numbers: &[f64], k: usize) {
-        for op in &self.ops {
-            let get = |s: Series| match s {
-                Series::Q(i) => e.q[i],
-                Series::V(i) => e.v[i],
-                Series::Temp(i) => e.temps[i],
-            };
-            let slot_value = |s: &Slot| numbers[self.number_index(*s)];
-            let value = match op {
-                Op::SinCos { sin, cos, a } => {
-                    let (s, c) = tay::sin_cos(&get(*sin), &get(*cos), &get(*a), k);
-                    let (Series::Temp(si), Series::Temp(ci)) = (sin, cos) else {
-                        unreachable!("pairs write temporaries")
-                    };
-                    e.temps[*si][k] = s;
-                    e.temps[*ci][k] = c;
-                    continue;
-                }
-                Op::Add {
-                    series, numbers, ..
-                } => {
-                    let mut x: f64 = series.iter().map(|s| get(*s)[k]).sum();
-                    if k == 0 {
-                        x += numbers.iter().map(slot_value).sum::<f64>();
-                    }
-                    x
-                }
-                Op::Scale { a, by, .. } => get(*a)[k] * slot_value(by),
-                Op::Mul { a, b, .. } => tay::mul(&get(*a), &get(*b), k),
-                Op::Square { a, .. } => tay::square(&get(*a), k),
-                Op::Recip { dst, a } => tay::recip(&get(*dst), &get(*a), k),
-                Op::Sqrt { dst, a } => tay::sqrt(&get(*dst), &get(*a), k),
-                Op::Power { dst, a, alpha } => tay::power(&get(*dst), &get(*a), *alpha, k),
-                Op::Exp { dst, a } => tay::exp(&get(*dst), &get(*a), k),
-                Op::Log { dst, a } => tay::log(&get(*dst), &get(*a), k),
-            };
-            let Series::Temp(d) = op.writes()[0] else {
-                unreachable!("ops write temporaries")
-            };
-            e.temps[d][k] = value;
-        }
-    }
-
-    /// Coefficient k of output `o`.
-    pub fn output(&self, e: &Evaluation, numbers: &[f64], o: usize, k: usize) -> f64 {
-        match self.outputs[o] {
-            Term::Number(s) if k == 0 => numbers[self.number_index(s)],
-            Term::Number(_) => 0.0,
-            Term::Series(Series::Q(i)) => e.q[i][k],
-            Term::Series(Series::V(i)) => e.v[i][k],
-            Term::Series(Series::Temp(i)) => e.temps[i][k],
-        }
-    }
-
-    /// The Taylor series of the motion q̈ = this program's outputs through
-    /// (q, v), to `order` (for tests and the interpreter; emitted code does
-    /// the same in straight-line Rust).
-    pub fn motion(&self, numbers: &[f64], q: &[f64], v: &[f64], order: usize) -> Evaluation {
-        let mut e = Evaluation {
-            q: vec![[0.0; tay::CAPACITY]; q.len()],
-            v: vec![[0.0; tay::CAPACITY]; v.len()],
-            temps: vec![[0.0; tay::CAPACITY]; self.temps],
-        };
-        for (c, x) in e.q.iter_mut().zip(q) {
-            c[0] = *x;
-        }
-        for (c, x) in e.v.iter_mut().zip(v) {
-            c[0] = *x;
-        }
-        let order = order.min(tay::MAX_ORDER);
-        for k in 0..order {
-            self.order(&mut e, numbers, k);
-            let ik = 1.0 / (k + 1) as f64;
-            for i in 0..v.len() {
-                e.q[i][k + 1] = e.v[i][k] * ik;
-                e.v[i][k + 1] = self.output(&e, numbers, i, k) * ik;
-            }
-        }
-        e
-    }
-
-    /// The coefficients of the first output along the coordinates' series
-    /// in `e` (its temporaries overwritten), orders 0 to `order`.
-    pub fn along(&self, numbers: &[f64], e: &mut Evaluation, order: usize) -> Coefficients {
-        e.temps = vec![[0.0; tay::CAPACITY]; self.temps];
-        let mut out = [0.0; tay::CAPACITY];
-        for (k, o) in out
-            .iter_mut()
-            .enumerate()
-            .take(order.min(tay::MAX_ORDER) + 1)
-        {
-            self.order(e, numbers, k);
-            *o = self.output(e, numbers, 0, k);
-        }
-        out
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use dalembert_runtime::taylor as tay;
 
     /// q̈ = −(g/l)·sin q (the pendulum): the transform's series of q is
     /// the solution's, checked against a tiny-step integration of the
