@@ -118,32 +118,31 @@ pub struct Interpreted<const N: usize> {
 
 /// The Taylor transforms of q̈ and of each wall's f (the generated model's
 /// `motion_series` and `{wall}_surface_series` do the same operations),
-/// with their time-constant values at the current parameters.
+/// each with its time-constant values at the current parameters
+/// ([`Transform::number_values`]).
 #[derive(Clone, Debug)]
 struct SeriesPrograms {
-    motion: Transform,
-    walls: Vec<Transform>,
-    /// [`Transform::number_values`] of `motion`, then of each wall.
-    numbers: Vec<Vec<f64>>,
+    motion: (Transform, Vec<f64>),
+    walls: Vec<(Transform, Vec<f64>)>,
 }
 
 impl SeriesPrograms {
     fn new((motion, walls): (Transform, Vec<Transform>), params: &[f64]) -> Self {
-        let mut s = Self {
-            motion,
-            walls,
-            numbers: Vec::new(),
+        let with_numbers = |t: Transform| {
+            let numbers = t.number_values(params, run_program);
+            (t, numbers)
         };
-        s.refresh(params);
-        s
+        Self {
+            motion: with_numbers(motion),
+            walls: walls.into_iter().map(with_numbers).collect(),
+        }
     }
 
     /// Recomputes the time-constant values (the parameters changed).
     fn refresh(&mut self, params: &[f64]) {
-        self.numbers = std::iter::once(&self.motion)
-            .chain(&self.walls)
-            .map(|t| t.number_values(params, run_program))
-            .collect();
+        for (t, numbers) in std::iter::once(&mut self.motion).chain(&mut self.walls) {
+            *numbers = t.number_values(params, run_program);
+        }
     }
 }
 
@@ -447,7 +446,8 @@ impl<const N: usize> Dynamics<N> for Interpreted<N> {
         let q: [f64; N] = std::array::from_fn(|i| series.q[i][0]);
         let v: [f64; N] = std::array::from_fn(|i| series.v[i][0]);
         let order = order.min(MAX_ORDER);
-        let e = sp.motion.motion(&sp.numbers[0], &q, &v, order);
+        let (motion, numbers) = &sp.motion;
+        let e = motion.motion(numbers, &q, &v, order);
         for i in 0..N {
             series.q[i] = e.q[i];
             series.v[i] = e.v[i];
@@ -465,11 +465,7 @@ impl<const N: usize> Surfaces<N> for Interpreted<N> {
         Some(self.scalar(&self.wall(wall).surface_hessian, q, v))
     }
     fn surface_series(&self, wall: WallIndex, series: &Series<N>, out: &mut Coefficients) -> bool {
-        let Some((t, numbers)) = self
-            .series
-            .as_ref()
-            .and_then(|s| Some((s.walls.get(wall.0)?, &s.numbers[wall.0 + 1])))
-        else {
+        let Some((t, numbers)) = self.series.as_ref().and_then(|s| s.walls.get(wall.0)) else {
             return false;
         };
         let mut e = Evaluation {
