@@ -82,6 +82,18 @@ impl<const N: usize> Series<N> {
         s
     }
 
+    /// Makes this the series of order 0 at (q, v), as [`Series::at`] does,
+    /// without clearing the coefficients above order 0: every reader of a
+    /// series stops at its `order`, so a buffer reused step after step
+    /// need not be zeroed again.
+    pub fn restart(&mut self, q: &[f64; N], v: &[f64; N]) {
+        for i in 0..N {
+            self.q[i][0] = q[i];
+            self.v[i][0] = v[i];
+        }
+        self.order = 0;
+    }
+
     /// The state at τ on the series (Horner's scheme, every component in
     /// step so that the 2N chains run side by side; each is [`eval`]'s).
     pub fn state(&self, tau: f64) -> ([f64; N], [f64; N]) {

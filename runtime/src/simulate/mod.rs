@@ -66,6 +66,7 @@ pub use types::{Collision, Residual, Settings, SimError, State, Stats, Step};
 
 use crate::Surfaces;
 use crate::dynamics::{accelerations, qdd};
+use crate::taylor::Series;
 use integrator::{Engine, Method, RungeKutta};
 use phase::{Phase, norm};
 use thresholds::{ADMISSIBLE, MAX_WALLS, ON_WALL, TAYLOR_REACH};
@@ -88,6 +89,13 @@ pub struct Simulator<'m, M: Surfaces<N>, const N: usize> {
     departing: u64,
     /// When the last collision happened.
     last_collision: Option<f64>,
+    /// Taylor's method: whether the next step tries a lower order first,
+    /// and which (`series.rs`).
+    low_order_first: bool,
+    low_order: usize,
+    /// Taylor's method: the series of the current step, a buffer reused
+    /// by every step.
+    series: Series<N>,
     stats: Stats,
 }
 
@@ -166,11 +174,11 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
         let mut stats = Stats::default();
         let f0 = derivative(model, &mut stats, start.t, &y)?;
         let engine = settings.integrator.engine();
-        let proposal = match engine {
-            Engine::RungeKutta(m) => m.initial_step(&y, &f0),
-            Engine::Taylor(_) => {
+        let (proposal, low_order) = match engine {
+            Engine::RungeKutta(m) => (m.initial_step(&y, &f0), 0),
+            Engine::Taylor(t) => {
                 series::offered(model, &start)?;
-                f64::INFINITY
+                (f64::INFINITY, t.low_order)
             }
         };
         Ok(Self {
@@ -183,6 +191,9 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
             proposal,
             departing,
             last_collision: None,
+            low_order_first: true,
+            low_order,
+            series: Series::at(&start.q, &start.v),
             stats,
         })
     }

@@ -100,8 +100,12 @@ pub struct Stats {
     pub rejected: u64,
     /// Collisions resolved.
     pub collisions: u64,
-    /// Evaluations of the equations of motion.
+    /// Evaluations of the equations of motion (with Taylor's method: series
+    /// computed, the lower-order trials included).
     pub evaluations: u64,
+    /// Steps of Taylor's method taken on a series of lower order than the
+    /// tolerance's (see [`super::Taylor::low_order`]).
+    pub low_order_steps: u64,
 }
 
 /// Why the simulation stopped.

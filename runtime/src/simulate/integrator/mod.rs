@@ -17,6 +17,7 @@ mod taylor;
 pub(crate) use dense::Dense;
 pub use dopri::DormandPrince;
 pub use rk4::Rk4;
+pub(crate) use taylor::Plan;
 pub use taylor::Taylor;
 
 use super::phase::Phase;
@@ -37,7 +38,7 @@ pub enum Integrator {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Engine {
     RungeKutta(RungeKutta),
-    Taylor(Taylor),
+    Taylor(Plan),
 }
 
 impl Integrator {
@@ -46,7 +47,7 @@ impl Integrator {
     pub fn valid(&self) -> bool {
         match self.engine() {
             Engine::RungeKutta(m) => m.valid(),
-            Engine::Taylor(t) => t.valid(),
+            Engine::Taylor(t) => t.method.valid(),
         }
     }
 
@@ -54,7 +55,7 @@ impl Integrator {
         match *self {
             Integrator::Rk4(m) => Engine::RungeKutta(RungeKutta::Rk4(m)),
             Integrator::DormandPrince(m) => Engine::RungeKutta(RungeKutta::DormandPrince(m)),
-            Integrator::Taylor(t) => Engine::Taylor(t),
+            Integrator::Taylor(t) => Engine::Taylor(Plan::new(t)),
         }
     }
 }

@@ -41,12 +41,51 @@ impl Taylor {
         (p as usize).clamp(2, MAX_ORDER)
     }
 
-    /// The step for the series `s` of order p (Jorba & Zou, eq. 3.9, with
-    /// the safety factor exp(−0.7/(p − 1)) heyoka uses):
-    /// h = ρ/e² · exp(−0.7/(p − 1)), ρ = min over j ∈ {p − 1, p} of
-    /// (max(1, ‖x₀‖∞)/‖xⱼ‖∞)^(1/j), the norms over every coordinate and
-    /// velocity. A series whose last two orders vanish (a polynomial
-    /// motion) takes the longest step.
+    /// The lower order tried first where a step is likely to end at a wall
+    /// or at the end of the run anyway (see [`crate::simulate`]'s Taylor
+    /// steps): half the order, at least 2. A convolution costs about k
+    /// multiply-adds at order k, so the series to p/2 costs about a quarter
+    /// of the series to p.
+    pub fn low_order(&self) -> usize {
+        (self.order() / 2).max(2)
+    }
+
+    /// The step for the series `s` of order p, the shorter of Jorba & Zou's
+    /// two estimates (§3.2): the last two terms below the tolerance,
+    /// h = min over j ∈ {p − 1, p} of (ε max(1, ‖x₀‖∞)/‖xⱼ‖∞)^(1/j), and
+    /// the asymptotic h = ρ/e² (eq. 3.9, ρ = min over j of
+    /// (max(1, ‖x₀‖∞)/‖xⱼ‖∞)^(1/j)), both with the safety factor
+    /// exp(−0.7/(p − 1)) heyoka uses; the norms are over every coordinate
+    /// and velocity. At the order the tolerance asks for the asymptotic step
+    /// is the shorter; at a lower order (`low_order`) the first one is. A
+    /// series whose last two orders vanish (a polynomial motion) takes the
+    /// longest step.
+    pub fn step<const N: usize>(&self, s: &Series<N>) -> f64 {
+        Plan::new(*self).step(s)
+    }
+}
+
+/// Taylor's settings with what every step reads worked out once.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Plan {
+    pub method: Taylor,
+    /// [`Taylor::order`] and [`Taylor::low_order`].
+    pub order: usize,
+    pub low_order: usize,
+    log_tolerance: f64,
+}
+
+impl Plan {
+    pub fn new(method: Taylor) -> Self {
+        Self {
+            method,
+            order: method.order(),
+            low_order: method.low_order(),
+            log_tolerance: libm::log(method.tolerance),
+        }
+    }
+
+    /// [`Taylor::step`].
     pub fn step<const N: usize>(&self, s: &Series<N>) -> f64 {
         let p = s.order;
         let norm = |j: usize| {
@@ -57,21 +96,23 @@ impl Taylor {
             m
         };
         let scale = norm(0).max(1.0);
-        // In logarithms: ln h = ln ρ − 2 − 0.7/(p − 1), two logarithms and
-        // one exponential per step.
-        let log_radius = |j: usize| {
+        let log_eps = self.log_tolerance;
+        // In logarithms: ln h = ln ρⱼ + min(ln ε / j, −2) − 0.7/(p − 1),
+        // a logarithm per order read and one exponential per step.
+        let log_step = |j: usize| {
             let x = norm(j);
             if x == 0.0 {
                 f64::INFINITY
             } else {
-                libm::log(scale / x) / j as f64
+                let j = j as f64;
+                libm::log(scale / x) / j + (log_eps / j).min(-2.0)
             }
         };
-        let log_rho = log_radius(p - 1).min(log_radius(p));
-        if log_rho == f64::INFINITY {
-            return self.max_step;
+        let log_h = log_step(p - 1).min(log_step(p));
+        if log_h == f64::INFINITY {
+            return self.method.max_step;
         }
-        libm::exp(log_rho - 2.0 - 0.7 / (p - 1) as f64).min(self.max_step)
+        libm::exp(log_h - 0.7 / (p - 1) as f64).min(self.method.max_step)
     }
 }
 
@@ -107,6 +148,17 @@ mod tests {
         let e2 = core::f64::consts::E * core::f64::consts::E;
         let want = rho / e2 * libm::exp(-0.7 / (p - 1.0));
         assert!(libm::fabs(h - want) <= 1e-15 * want);
+        // At the lower order the last two terms bound the step:
+        // h = min over j ∈ {7, 8} of (ε/‖x_j‖)^(1/j), shorter than ρ/e².
+        assert_eq!(t.low_order(), 10);
+        s.order = 8;
+        let eps = t.tolerance;
+        let h8 = t.step(&s);
+        let trunc = libm::pow(eps / 8.0, 1.0 / 7.0).min(libm::pow(eps / 9.0, 1.0 / 8.0));
+        let want = trunc * libm::exp(-0.7 / 7.0);
+        assert!(libm::fabs(h8 - want) <= 1e-14 * want, "{h8} {want}");
+        let rho8 = libm::pow(1.0 / 8.0, 1.0 / 7.0).min(libm::pow(1.0 / 9.0, 1.0 / 8.0));
+        assert!(h8 < rho8 / e2 * libm::exp(-0.7 / 7.0));
         // A polynomial motion: no limit but the longest step.
         let mut line = Series::<1>::at(&[0.0], &[1.0]);
         line.q[0][1] = 1.0;
