@@ -282,7 +282,7 @@ pub const TABLE: &[Spec] = &[
         name: "collide",
         inputs: Inputs::Phase,
         shape: Shape::Vector,
-        doc: "Wall `{wall}`: the collision map v⁺ = (I − 2P)v⁻.",
+        doc: "Wall `{wall}`: the collision map v⁺ = (I − 2P)v⁻ for admissible v⁻ (A v⁻ = 0; elsewhere it may differ from (I − 2P)v⁻, see the header's solves).",
         capability: Capability::Walls,
         method: Some(("collide", Forward::Plain)),
     },

@@ -80,7 +80,10 @@ pub trait Walls<const Q: usize, const N: usize>: Model<Q, N> {
     fn wall_rows(&self, wall: Self::Wall, q: &[f64; Q]) -> Rows<N>;
     /// The G-orthogonal projector P onto (ker B)^⊥ (eq. 2.4).
     fn projector(&self, wall: Self::Wall, q: &[f64; Q]) -> [[f64; N]; N];
-    /// The collision map v⁺ = (I − 2P) v⁻ (eq. 2.13).
+    /// The collision map v⁺ = (I − 2P) v⁻ (eq. 2.13) for admissible v⁻
+    /// (A v⁻ = 0, the velocities a motion has). Generated code may use
+    /// A v⁻ = 0 to shorten the map, so for other v it can differ from
+    /// (I − 2P)v; [`Walls::projector`] gives P itself.
     fn collide(&self, wall: Self::Wall, q: &[f64; Q], v: &[f64; N]) -> [f64; N];
 
     /// The wall's normal row (df(q) in a model with coordinates; the first

@@ -68,6 +68,9 @@ pub enum Projection {
 pub enum Form {
     /// M v with M = I − 2P computed once per parameter set (P free of q).
     Linear,
+    /// The same on admissible v only (A v = 0): M's columns of k dependent
+    /// velocities folded into the others, M̃ = M − M_D A_D⁻¹ A.
+    Admissible,
     /// The exact closed form of (I − 2P)v.
     ClosedForm,
     /// G = LDLᵀ and the solve with B's rows written out over one program
@@ -80,6 +83,7 @@ impl Form {
     pub fn label(self) -> &'static str {
         match self {
             Self::Linear => "linear",
+            Self::Admissible => "admissible",
             Self::ClosedForm => "closed form",
             Self::Elimination => "elimination",
         }
@@ -89,6 +93,9 @@ impl Form {
     pub fn describe(self) -> &'static str {
         match self {
             Self::Linear => "M v, M = I - 2P kept with the parameters",
+            Self::Admissible => {
+                "M v on admissible v (A v = 0 folds the columns of dependent velocities into the others), M kept with the parameters"
+            }
             Self::ClosedForm => "the exact closed form",
             Self::Elimination => "elimination (G = LDL^T and the solve written out)",
         }

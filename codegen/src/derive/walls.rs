@@ -100,6 +100,9 @@ fn wall(
             if let Some(f) = linear_collision(c, cx, p, &w.span)? {
                 candidates.push((Form::Linear, f));
             }
+            if let Some(f) = admissible_collision(c, cx, p, &w.span)? {
+                candidates.push((Form::Admissible, f));
+            }
             if let Some(f) = c
                 .compile
                 .applicable(cx, Quantity::Collide, collide, 0, &w.span)?
@@ -215,13 +218,7 @@ fn closed_form(
 ) -> Option<(Vec<Vec<Atom>>, Vec<Atom>)> {
     let n = sym.vels.len();
     let p = projector(g_inv, b)?;
-    let p_atoms: Vec<Vec<Atom>> = (0..n)
-        .map(|i| {
-            (0..n)
-                .map(|j| low.simplify(&p[(i as u32, j as u32)]))
-                .collect()
-        })
-        .collect();
+    let p_atoms = simplified(low, &p, n, n);
     let collide = (0..n)
         .map(|i| {
             let mut s = sym.vel(i);
@@ -245,29 +242,160 @@ fn linear_collision(
     p: &[Vec<Atom>],
     span: &std::ops::Range<usize>,
 ) -> Result<Option<Function>, Reported> {
-    let sym = c.sym;
-    let varies = |e: &Atom| sym.coords.iter().any(|q| !is_zero(&e.derivative(*q)));
-    if p.iter().flatten().any(varies) {
+    if p.iter().flatten().any(|e| varies(c, e)) {
         return Ok(None);
     }
+    linear_map(c, cx, &reflection(p), span)
+}
+
+/// The collision map on admissible velocities (A v = 0, the only ones a
+/// collision meets) as v⁺ = M̃ v with M = I − 2P kept with the parameters
+/// as in [`linear_collision`]: A v = 0 writes k components v_D of v (A_D
+/// invertible) through the others, so M's columns D fold into the rest,
+/// M̃ = M − M_D A_D⁻¹ A, which is zero in the columns D and equal to M on
+/// ker A. Of every such D, the one with the fewest operations per call;
+/// `None` without constraints, where P or A_D⁻¹A varies with q, or where
+/// no D needs fewer operations than M.
+fn admissible_collision(
+    c: &Context,
+    cx: &mut Collector,
+    p: &[Vec<Atom>],
+    span: &std::ops::Range<usize>,
+) -> Result<Option<Function>, Reported> {
+    let (a, field, low) = (&c.exact.a, &c.exact.field, c.low);
+    let (n, k) = (c.sym.vels.len(), a.len());
+    if k == 0 || k >= n || p.iter().flatten().any(|e| varies(c, e)) {
+        return Ok(None);
+    }
+    let Some(a_mat) = rows_matrix(a, n, field) else {
+        return Ok(None);
+    };
+    let m = reflection(p);
+    // Per call: a multiplication per entry that is not 0 or ±1, and an
+    // addition per further term of a row.
+    let cost = |rows: &[Vec<Atom>]| -> usize {
+        rows.iter()
+            .map(|row| {
+                let terms = row.iter().filter(|x| !is_zero(x)).count();
+                let unit = row
+                    .iter()
+                    .filter(|x| {
+                        is_zero(&((*x).clone() - Atom::num(1)))
+                            || is_zero(&((*x).clone() + Atom::num(1)))
+                    })
+                    .count();
+                (terms - unit) + terms.saturating_sub(1)
+            })
+            .sum()
+    };
+    let mut best: Option<(usize, Vec<Vec<Atom>>)> = None;
+    for d in subsets(n, k) {
+        let a_d: Vec<Rat> = a
+            .iter()
+            .flat_map(|row| d.iter().map(|&j| row[j].clone()))
+            .collect();
+        let Ok(a_d) = Matrix::from_linear(a_d, k as u32, k as u32, field.clone()) else {
+            continue;
+        };
+        let Ok(inv) = a_d.inv() else {
+            continue;
+        };
+        let through = simplified(low, &(&inv * &a_mat), k, n);
+        if through.iter().flatten().any(|e| varies(c, e)) {
+            continue;
+        }
+        let folded: Vec<Vec<Atom>> = (0..n)
+            .map(|i| {
+                (0..n)
+                    .map(|j| {
+                        let mut e = m[i][j].clone();
+                        for (t, &dt) in d.iter().enumerate() {
+                            e -= m[i][dt].clone() * through[t][j].clone();
+                        }
+                        low.simplify(&low.to_rat(&e))
+                    })
+                    .collect()
+            })
+            .collect();
+        let count = cost(&folded);
+        if best.as_ref().is_none_or(|(b, _)| count < *b) {
+            best = Some((count, folded));
+        }
+    }
+    match best {
+        Some((count, folded)) if count < cost(&m) => linear_map(c, cx, &folded, span),
+        _ => Ok(None),
+    }
+}
+
+/// The entries of a rows × cols matrix, simplified.
+fn simplified(low: &Lowering, m: &Matrix<Field>, rows: usize, cols: usize) -> Vec<Vec<Atom>> {
+    (0..rows)
+        .map(|i| {
+            (0..cols)
+                .map(|j| low.simplify(&m[(i as u32, j as u32)]))
+                .collect()
+        })
+        .collect()
+}
+
+/// Whether `e` depends on the coordinates.
+fn varies(c: &Context, e: &Atom) -> bool {
+    c.sym.coords.iter().any(|q| !is_zero(&e.derivative(*q)))
+}
+
+/// M = I − 2P.
+fn reflection(p: &[Vec<Atom>]) -> Vec<Vec<Atom>> {
+    p.iter()
+        .enumerate()
+        .map(|(i, row)| {
+            row.iter()
+                .enumerate()
+                .map(|(j, pij)| Atom::num(i64::from(i == j)) - Atom::num(2) * pij.clone())
+                .collect()
+        })
+        .collect()
+}
+
+/// The k-element subsets of 0..n in lexicographic order.
+fn subsets(n: usize, k: usize) -> Vec<Vec<usize>> {
+    let mut out = Vec::new();
+    let mut d: Vec<usize> = (0..k).collect();
+    loop {
+        out.push(d.clone());
+        let Some(t) = (0..k).rev().find(|&t| d[t] < n - k + t) else {
+            return out;
+        };
+        d[t] += 1;
+        for u in t + 1..k {
+            d[u] = d[u - 1] + 1;
+        }
+    }
+}
+
+/// v⁺ = M v as a function: M's entries that are not 0 or ±1 are the
+/// program's (parameter-only) outputs, one multiplication each per call.
+fn linear_map(
+    c: &Context,
+    cx: &mut Collector,
+    m: &[Vec<Atom>],
+    span: &std::ops::Range<usize>,
+) -> Result<Option<Function>, Reported> {
+    let sym = c.sym;
     let n = sym.vels.len();
     let mut entries = Vec::with_capacity(n * n);
     let mut general = Vec::new();
-    for (i, row) in p.iter().enumerate() {
-        for (j, pij) in row.iter().enumerate() {
-            let delta = Atom::num(i64::from(i == j));
-            let m = delta - Atom::num(2) * pij.clone();
-            entries.push(if is_zero(&m) {
-                Entry::Zero
-            } else if is_zero(&(m.clone() - Atom::num(1))) {
-                Entry::One
-            } else if is_zero(&(m.clone() + Atom::num(1))) {
-                Entry::MinusOne
-            } else {
-                general.push(m);
-                Entry::General
-            });
-        }
+    for m in m.iter().flatten() {
+        entries.push(if is_zero(m) {
+            Entry::Zero
+        } else if is_zero(&(m.clone() - Atom::num(1))) {
+            Entry::One
+        } else if is_zero(&(m.clone() + Atom::num(1))) {
+            Entry::MinusOne
+        } else {
+            general.push(m.clone());
+            Entry::General
+        });
     }
     let Some(f) = c
         .compile
