@@ -69,7 +69,8 @@ pub enum Form {
     /// M v with M = I − 2P computed once per parameter set (P free of q).
     Linear,
     /// The same on admissible v only (A v = 0): M's columns of k dependent
-    /// velocities folded into the others, M̃ = M − M_D A_D⁻¹ A.
+    /// velocities folded into the others, M̃ = M − M_D A_D⁻¹ A, and
+    /// dependent components of v⁺ computed from the others where cheaper.
     Admissible,
     /// The exact closed form of (I − 2P)v.
     ClosedForm,
@@ -94,7 +95,7 @@ impl Form {
         match self {
             Self::Linear => "M v, M = I - 2P kept with the parameters",
             Self::Admissible => {
-                "M v on admissible v (A v = 0 folds the columns of dependent velocities into the others), M kept with the parameters"
+                "M v on admissible v (A v = 0 folds the columns of dependent velocities into the others; A v+ = 0 gives dependent outputs from the others), M kept with the parameters"
             }
             Self::ClosedForm => "the exact closed form",
             Self::Elimination => "elimination (G = LDL^T and the solve written out)",

@@ -245,17 +245,20 @@ fn linear_collision(
     if p.iter().flatten().any(|e| varies(c, e)) {
         return Ok(None);
     }
-    linear_map(c, cx, &reflection(p), span)
+    linear_map(c, cx, &reflection(p), &vec![false; p.len()], span)
 }
 
 /// The collision map on admissible velocities (A v = 0, the only ones a
-/// collision meets) as v⁺ = M̃ v with M = I − 2P kept with the parameters
-/// as in [`linear_collision`]: A v = 0 writes k components v_D of v (A_D
-/// invertible) through the others, so M's columns D fold into the rest,
-/// M̃ = M − M_D A_D⁻¹ A, which is zero in the columns D and equal to M on
-/// ker A. Of every such D, the one with the fewest operations per call;
-/// `None` without constraints, where P or A_D⁻¹A varies with q, or where
-/// no D needs fewer operations than M.
+/// collision meets) from M = I − 2P kept with the parameters as in
+/// [`linear_collision`], shortened twice by A's rows. On the inputs: A v =
+/// 0 writes k components v_D (A_D invertible) through the others, so M's
+/// columns D fold into the rest, M̃ = M − M_D A_D⁻¹A, zero in the columns D
+/// and equal to M on ker A. On the outputs: v⁺ is admissible too (A P = A,
+/// so A v⁺ = −A v = 0), so k components v⁺_E (A_E invertible) can instead be
+/// computed from the others, v⁺_E = −(A_E⁻¹A)_Ē v⁺_Ē, where that row is
+/// cheaper. Of every such D and E (or none), the pair with the fewest
+/// operations per call; `None` without constraints, where P or A_D⁻¹A varies
+/// with q, or where nothing is saved against M v.
 fn admissible_collision(
     c: &Context,
     cx: &mut Collector,
@@ -271,24 +274,8 @@ fn admissible_collision(
         return Ok(None);
     };
     let m = reflection(p);
-    // Per call: a multiplication per entry that is not 0 or ±1, and an
-    // addition per further term of a row.
-    let cost = |rows: &[Vec<Atom>]| -> usize {
-        rows.iter()
-            .map(|row| {
-                let terms = row.iter().filter(|x| !is_zero(x)).count();
-                let unit = row
-                    .iter()
-                    .filter(|x| {
-                        is_zero(&((*x).clone() - Atom::num(1)))
-                            || is_zero(&((*x).clone() + Atom::num(1)))
-                    })
-                    .count();
-                (terms - unit) + terms.saturating_sub(1)
-            })
-            .sum()
-    };
-    let mut best: Option<(usize, Vec<Vec<Atom>>)> = None;
+    // A_D⁻¹A for every D with A_D invertible and A_D⁻¹A free of q.
+    let mut through: Vec<(Vec<usize>, Vec<Vec<Atom>>)> = Vec::new();
     for d in subsets(n, k) {
         let a_d: Vec<Rat> = a
             .iter()
@@ -300,32 +287,74 @@ fn admissible_collision(
         let Ok(inv) = a_d.inv() else {
             continue;
         };
-        let through = simplified(low, &(&inv * &a_mat), k, n);
-        if through.iter().flatten().any(|e| varies(c, e)) {
-            continue;
+        let t = simplified(low, &(&inv * &a_mat), k, n);
+        if !t.iter().flatten().any(|e| varies(c, e)) {
+            through.push((d, t));
         }
+    }
+    let mut best: Option<(usize, Vec<Vec<Atom>>, Vec<bool>)> = None;
+    for (d, t) in &through {
         let folded: Vec<Vec<Atom>> = (0..n)
             .map(|i| {
                 (0..n)
                     .map(|j| {
                         let mut e = m[i][j].clone();
-                        for (t, &dt) in d.iter().enumerate() {
-                            e -= m[i][dt].clone() * through[t][j].clone();
+                        for (s, &ds) in d.iter().enumerate() {
+                            e -= m[i][ds].clone() * t[s][j].clone();
                         }
                         low.simplify(&low.to_rat(&e))
                     })
                     .collect()
             })
             .collect();
-        let count = cost(&folded);
-        if best.as_ref().is_none_or(|(b, _)| count < *b) {
-            best = Some((count, folded));
+        let rows: Vec<usize> = folded.iter().map(|r| row_cost(r)).collect();
+        // Outputs E computed from the others (rows over v⁺), each where
+        // that is cheaper; E = ∅ first.
+        let mut options: Vec<(Vec<Vec<Atom>>, Vec<bool>)> = vec![(folded.clone(), vec![false; n])];
+        for (e, te) in &through {
+            let mut rows_e = folded.clone();
+            let mut over = vec![false; n];
+            for (s, &es) in e.iter().enumerate() {
+                let from_outputs: Vec<Atom> = (0..n)
+                    .map(|j| {
+                        if e.contains(&j) {
+                            Atom::num(0)
+                        } else {
+                            -te[s][j].clone()
+                        }
+                    })
+                    .collect();
+                if row_cost(&from_outputs) < rows[es] {
+                    rows_e[es] = from_outputs;
+                    over[es] = true;
+                }
+            }
+            options.push((rows_e, over));
+        }
+        for (rows_e, over) in options {
+            let total: usize = rows_e.iter().map(|r| row_cost(r)).sum();
+            if best.as_ref().is_none_or(|(b, _, _)| total < *b) {
+                best = Some((total, rows_e, over));
+            }
         }
     }
+    let plain: usize = m.iter().map(|r| row_cost(r)).sum();
     match best {
-        Some((count, folded)) if count < cost(&m) => linear_map(c, cx, &folded, span),
+        Some((total, rows, over)) if total < plain => linear_map(c, cx, &rows, &over, span),
         _ => Ok(None),
     }
+}
+
+/// Operations per call of one row of a linear map: a multiplication per
+/// entry that is not 0 or ±1, a negation per −1, an addition per further
+/// term.
+fn row_cost(row: &[Atom]) -> usize {
+    let terms = row.iter().filter(|x| !is_zero(x)).count();
+    let ones = row
+        .iter()
+        .filter(|x| is_zero(&((*x).clone() - Atom::num(1))))
+        .count();
+    (terms - ones) + terms.saturating_sub(1)
 }
 
 /// The entries of a rows × cols matrix, simplified.
@@ -374,11 +403,13 @@ fn subsets(n: usize, k: usize) -> Vec<Vec<usize>> {
 }
 
 /// v⁺ = M v as a function: M's entries that are not 0 or ±1 are the
-/// program's (parameter-only) outputs, one multiplication each per call.
+/// program's (parameter-only) outputs, one multiplication each per call;
+/// the rows `over_outputs` multiply v⁺ (the other rows) instead of v.
 fn linear_map(
     c: &Context,
     cx: &mut Collector,
     m: &[Vec<Atom>],
+    over_outputs: &[bool],
     span: &std::ops::Range<usize>,
 ) -> Result<Option<Function>, Reported> {
     let sym = c.sym;
@@ -405,7 +436,9 @@ fn linear_map(
     };
     let velocities = sym.params.len() + sym.coords.len();
     Ok(Some(Function {
-        program: f.program.times_vector(&entries, n, velocities),
+        program: f
+            .program
+            .times_vector_folded(&entries, over_outputs, n, velocities),
         ..f
     }))
 }

@@ -373,7 +373,7 @@ impl BallFloor {
             [o30, o31, o32, o33, o34, o35],
         ]
     }
-    /// Wall `floor`: the collision map v⁺ = (I − 2P)v⁻.
+    /// Wall `floor`: the collision map v⁺ = (I − 2P)v⁻ for admissible v⁻ (A v⁻ = 0; elsewhere it may differ from (I − 2P)v⁻, see the header's solves).
     #[inline]
     #[allow(unused_variables, clippy::approx_constant)]
     pub fn floor_collide(&self, q: &[f32; 0], v: &[f32; 6]) -> [f32; 6] {

@@ -697,7 +697,7 @@ impl BallWallEuler {
             [o20, o21, o22, o23, o24],
         ]
     }
-    /// Wall `wall`: the collision map v⁺ = (I − 2P)v⁻.
+    /// Wall `wall`: the collision map v⁺ = (I − 2P)v⁻ for admissible v⁻ (A v⁻ = 0; elsewhere it may differ from (I − 2P)v⁻, see the header's solves).
     #[inline]
     #[allow(unused_variables, clippy::approx_constant)]
     pub fn wall_collide(&self, q: &[f32; 5], v: &[f32; 5]) -> [f32; 5] {
