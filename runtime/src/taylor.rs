@@ -75,10 +75,7 @@ impl<const N: usize> Series<N> {
             v: [[0.0; CAPACITY]; N],
             order: 0,
         };
-        for i in 0..N {
-            s.q[i][0] = q[i];
-            s.v[i][0] = v[i];
-        }
+        s.restart(q, v);
         s
     }
 

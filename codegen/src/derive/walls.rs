@@ -97,11 +97,19 @@ fn wall(
                 c.compile
                     .applicable(cx, Quantity::Projector, &flat, 0, &w.span)?,
             );
-            if let Some(f) = linear_collision(c, cx, p, &w.span)? {
-                candidates.push((Form::Linear, f));
-            }
-            if let Some(f) = admissible_collision(c, cx, p, &w.span)? {
-                candidates.push((Form::Admissible, f));
+            // Where P does not depend on q, M = I − 2P is parameter-only
+            // work, done once, and a call is one multiplication per entry
+            // that is not 0 or ±1: M v, and M shortened by A's rows. (Where
+            // P depends on q, (I − 2P)v as an expression of q and v is
+            // cheaper than M's n² entries.)
+            if !p.iter().flatten().any(|e| varies(c, e)) {
+                let m = reflection(p);
+                if let Some(f) = linear_map(c, cx, &m, &vec![false; m.len()], &w.span)? {
+                    candidates.push((Form::Linear, f));
+                }
+                if let Some(f) = admissible_collision(c, cx, &m, &w.span)? {
+                    candidates.push((Form::Admissible, f));
+                }
             }
             if let Some(f) = c
                 .compile
@@ -231,49 +239,31 @@ fn closed_form(
     Some((p_atoms, collide))
 }
 
-/// The collision map as v⁺ = M v with M = I − 2P, where P does not depend
-/// on the coordinates: M's entries are then parameter-only work, done once,
-/// and a call is one multiplication per entry that is not 0 or ±1. `None`
-/// where P depends on q (there (I − 2P)v as an expression of q and v is
-/// cheaper than M's n² entries).
-fn linear_collision(
-    c: &Context,
-    cx: &mut Collector,
-    p: &[Vec<Atom>],
-    span: &std::ops::Range<usize>,
-) -> Result<Option<Function>, Reported> {
-    if p.iter().flatten().any(|e| varies(c, e)) {
-        return Ok(None);
-    }
-    linear_map(c, cx, &reflection(p), &vec![false; p.len()], span)
-}
-
 /// The collision map on admissible velocities (A v = 0, the only ones a
-/// collision meets) from M = I − 2P kept with the parameters as in
-/// [`linear_collision`], shortened twice by A's rows. On the inputs: A v =
+/// collision meets) from M = I − 2P (free of q, kept with the parameters),
+/// shortened twice by A's rows. On the inputs: A v =
 /// 0 writes k components v_D (A_D invertible) through the others, so M's
 /// columns D fold into the rest, M̃ = M − M_D A_D⁻¹A, zero in the columns D
 /// and equal to M on ker A. On the outputs: v⁺ is admissible too (A P = A,
 /// so A v⁺ = −A v = 0), so k components v⁺_E (A_E invertible) can instead be
 /// computed from the others, v⁺_E = −(A_E⁻¹A)_Ē v⁺_Ē, where that row is
 /// cheaper. Of every such D and E (or none), the pair with the fewest
-/// operations per call; `None` without constraints, where P or A_D⁻¹A varies
+/// operations per call; `None` without constraints, where A_D⁻¹A varies
 /// with q, or where nothing is saved against M v.
 fn admissible_collision(
     c: &Context,
     cx: &mut Collector,
-    p: &[Vec<Atom>],
+    m: &[Vec<Atom>],
     span: &std::ops::Range<usize>,
 ) -> Result<Option<Function>, Reported> {
     let (a, field, low) = (&c.exact.a, &c.exact.field, c.low);
     let (n, k) = (c.sym.vels.len(), a.len());
-    if k == 0 || k >= n || p.iter().flatten().any(|e| varies(c, e)) {
+    if k == 0 || k >= n {
         return Ok(None);
     }
     let Some(a_mat) = rows_matrix(a, n, field) else {
         return Ok(None);
     };
-    let m = reflection(p);
     // A_D⁻¹A for every D with A_D invertible and A_D⁻¹A free of q.
     let mut through: Vec<(Vec<usize>, Vec<Vec<Atom>>)> = Vec::new();
     for d in subsets(n, k) {
