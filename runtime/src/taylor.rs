@@ -31,6 +31,19 @@ pub const MAX_ORDER: usize = CAPACITY - 1;
 /// The coefficients of one function of time.
 pub type Coefficients = [f64; CAPACITY];
 
+/// 1/k for k = 1 to [`CAPACITY`] (entry 0 is 0): the recurrences' divisions
+/// by the order as multiplications, which take a few cycles where a
+/// division takes tens, on the chain from one order to the next.
+pub const RECIPROCALS: [f64; CAPACITY + 1] = {
+    let mut r = [0.0; CAPACITY + 1];
+    let mut k = 1;
+    while k <= CAPACITY {
+        r[k] = 1.0 / k as f64;
+        k += 1;
+    }
+    r
+};
+
 /// An intermediate series of which generated code only ever reads the
 /// coefficient of the order it is computing (a sum's or a product's result
 /// that no recurrence reads back): it keeps that coefficient alone, and
@@ -207,14 +220,14 @@ pub fn power_finish(c: &Coefficients, a: &Coefficients, alpha: f64, h: f64, k: u
 /// Coefficient k ≥ 1 of c = eᵃ from the [`weighted_history`] h of a with c.
 #[inline(always)]
 pub fn exp_finish(c: &Coefficients, a: &Coefficients, h: f64, k: usize) -> f64 {
-    ((k as f64 * a[k]) * c[0] + h) / k as f64
+    ((k as f64 * a[k]) * c[0] + h) * RECIPROCALS[k]
 }
 
 /// Coefficient k ≥ 1 of ln a from the [`weighted_history`] h of ln a with
 /// a.
 #[inline(always)]
 pub fn log_finish(a: &Coefficients, h: f64, k: usize) -> f64 {
-    (a[k] - h / k as f64) / a[0]
+    (a[k] - h * RECIPROCALS[k]) / a[0]
 }
 
 /// Coefficient k ≥ 1 of (sin a, cos a) from the [`weighted_history`] of a
@@ -228,9 +241,9 @@ pub fn sin_cos_finish(
     hc: f64,
     k: usize,
 ) -> (f64, f64) {
-    let kf = k as f64;
-    let dk = kf * a[k];
-    ((dk * c[0] + hs) / kf, -(dk * s[0] + hc) / kf)
+    let dk = k as f64 * a[k];
+    let ik = RECIPROCALS[k];
+    ((dk * c[0] + hs) * ik, -(dk * s[0] + hc) * ik)
 }
 
 /// Coefficient k of a·b.
@@ -381,6 +394,15 @@ mod tests {
             assert!(close(w[k], binom_alpha), "power {k}");
             let ln = if k == 0 { 0.0 } else { -sign / k as f64 };
             assert!(close(l[k], ln), "log {k}");
+        }
+    }
+
+    /// The table holds exactly the rounded 1/k.
+    #[test]
+    fn reciprocals() {
+        assert_eq!(RECIPROCALS[0], 0.0);
+        for (k, r) in RECIPROCALS.iter().enumerate().skip(1) {
+            assert_eq!(*r, 1.0 / k as f64, "{k}");
         }
     }
 

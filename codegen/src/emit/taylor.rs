@@ -66,7 +66,7 @@ pub(super) fn functions(d: &Ctx) -> TokenStream {
             #motion_prelude
             for k in 0..order {
                 #motion_ops
-                let ik = 1.0 / (k + 1) as f64;
+                let ik = ::dalembert_runtime::taylor::RECIPROCALS[k + 1];
                 #(#feedback)*
             }
             s.order = order;

@@ -145,8 +145,11 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         // Another wall at or beyond reach within the window, moving as after
         // this collision?
         for (j, &other) in m.walls().iter().enumerate() {
+            if j == k {
+                continue;
+            }
             let rate = m.normal_velocity(other, &y.q, &v_plus).min(0.0);
-            if j != k && m.surface(other, &y.q) + window * rate <= 0.0 {
+            if m.surface(other, &y.q) + window * rate <= 0.0 {
                 return Err(SimError::Simultaneous {
                     first: wall,
                     second: other,

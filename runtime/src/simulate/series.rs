@@ -222,11 +222,14 @@ fn first_root(c: &Coefficients, order: usize, h: f64, departing: bool) -> Result
     // Trailing zeros cost evaluations and say nothing (a flight's f is
     // often of degree 2).
     let order = degree(c, order);
-    let mut rate = [0.0; CAPACITY];
-    for k in 0..order {
-        rate[k] = (k + 1) as f64 * c[k + 1];
-    }
-    let low = order.saturating_sub(1);
+    // f's derivative, for the turning points (rarely needed: made on demand).
+    let turn = |a: f64, b: f64| {
+        let mut rate = [0.0; CAPACITY];
+        for k in 0..order {
+            rate[k] = (k + 1) as f64 * c[k + 1];
+        }
+        root(&rate, order.saturating_sub(1), a, b)
+    };
     let at = |tau: f64| eval_with_derivative(c, order, tau);
     let (f0, r0) = (c[0], c[1]);
     let mut leaving = departing && f0 <= 0.0 && r0 > 0.0;
@@ -250,7 +253,7 @@ fn first_root(c: &Coefficients, order: usize, h: f64, departing: bool) -> Result
             if f > 0.0 {
                 leaving = false;
             } else if r <= 0.0 {
-                let top = root(&rate, low, prev.0, tau);
+                let top = turn(prev.0, tau);
                 if eval(c, order, top) > 0.0 {
                     return Ok(Some(root(c, order, top, tau)));
                 }
@@ -260,7 +263,7 @@ fn first_root(c: &Coefficients, order: usize, h: f64, departing: bool) -> Result
             return Ok(Some(root(c, order, prev.0, tau)));
         } else if prev.2 < 0.0 && r > 0.0 {
             // Positive at both samples but turning: check the dip's bottom.
-            let bottom = root(&rate, low, prev.0, tau);
+            let bottom = turn(prev.0, tau);
             if eval(c, order, bottom) <= 0.0 {
                 return Ok(Some(root(c, order, prev.0, bottom)));
             }
@@ -271,8 +274,9 @@ fn first_root(c: &Coefficients, order: usize, h: f64, departing: bool) -> Result
 }
 
 /// A root of the polynomial in [a, b], where its sign changes: Newton's
-/// method from the secant point, bisection wherever Newton would leave the
-/// bracket, until the step is below rounding.
+/// method from the closed-form root for a degree of 2 or less (then one
+/// step confirms it), else from the secant point, bisection wherever Newton
+/// would leave the bracket, until the step is below rounding.
 fn root(c: &Coefficients, order: usize, mut a: f64, mut b: f64) -> f64 {
     let (fa, fb) = (eval(c, order, a), eval(c, order, b));
     if fa == 0.0 {
@@ -282,7 +286,13 @@ fn root(c: &Coefficients, order: usize, mut a: f64, mut b: f64) -> f64 {
         return b;
     }
     let above_at_a = fa > 0.0;
-    let mut x = a - fa * (b - a) / (fb - fa);
+    let mut x = match (order <= 2)
+        .then(|| quadratic_root(c, order, a, b))
+        .flatten()
+    {
+        Some(x) => x,
+        None => a - fa * (b - a) / (fb - fa),
+    };
     if !(x > a && x < b) {
         x = 0.5 * (a + b);
     }
@@ -308,6 +318,27 @@ fn root(c: &Coefficients, order: usize, mut a: f64, mut b: f64) -> f64 {
         x = next;
     }
     x
+}
+
+/// A root of c₀ + c₁τ + c₂τ² (the polynomial of `order` ≤ 2) in (a, b), by the formula that loses no
+/// digits to cancellation (the larger root from −(c₁ + sign(c₁)√d)/2, the
+/// other from the product of the roots); `None` where no root is found
+/// there (a rounding-level discriminant, or a root just outside).
+fn quadratic_root(c: &Coefficients, order: usize, a: f64, b: f64) -> Option<f64> {
+    let coefficient = |k: usize| if k <= order { c[k] } else { 0.0 };
+    let (c0, c1, c2) = (c[0], coefficient(1), coefficient(2));
+    let inside = |x: f64| (x > a && x < b).then_some(x);
+    if c2 == 0.0 {
+        return if c1 == 0.0 { None } else { inside(-c0 / c1) };
+    }
+    let d = c1 * c1 - 4.0 * c2 * c0;
+    if d < 0.0 {
+        return None;
+    }
+    let q = -0.5 * (c1 + libm::copysign(libm::sqrt(d), c1));
+    let first = q / c2;
+    let second = if q == 0.0 { first } else { c0 / q };
+    inside(first.min(second)).or_else(|| inside(first.max(second)))
 }
 
 #[cfg(test)]
@@ -345,6 +376,29 @@ mod tests {
         assert!((tau - want).abs() <= 2.0 * f64::EPSILON * want);
         // The same state not departing is at the wall already.
         assert_eq!(first_root(&c, 2, 1.0, false), Ok(Some(0.0)));
+    }
+
+    /// The closed-form start of the root search: the root in the bracket,
+    /// to a few ulps, where the textbook formula would lose the small root
+    /// to cancellation; linear and rootless cases.
+    #[test]
+    fn quadratic_roots() {
+        // (τ − 1e-9)(τ − 1e3) = τ² − (1e3 + 1e-9)τ + 1e-6.
+        let c = poly(&[1e-6, -(1e3 + 1e-9), 1.0]);
+        let small = quadratic_root(&c, 2, 0.0, 1.0).unwrap();
+        assert!((small - 1e-9).abs() <= 4.0 * f64::EPSILON * 1e-9, "{small}");
+        let large = quadratic_root(&c, 2, 1.0, 2e3).unwrap();
+        assert!((large - 1e3).abs() <= 4.0 * f64::EPSILON * 1e3, "{large}");
+        // Coefficients above the order are not read.
+        let c = poly(&[1.0, -2.0, 5.0]);
+        assert_eq!(quadratic_root(&c, 1, 0.0, 1.0), Some(0.5));
+        // No real root; a root outside the bracket.
+        assert_eq!(quadratic_root(&poly(&[1.0, 0.0, 1.0]), 2, -9.0, 9.0), None);
+        assert_eq!(quadratic_root(&poly(&[1.0, -2.0]), 1, 0.0, 0.4), None);
+        // root() lands on the same value from the closed form.
+        let c = poly(&[1e-6, -(1e3 + 1e-9), 1.0]);
+        let r = root(&c, 2, 0.0, 1.0);
+        assert!((r - 1e-9).abs() <= 4.0 * f64::EPSILON * 1e-9, "{r}");
     }
 
     /// A dip that touches down between two samples is found at its

@@ -128,7 +128,7 @@ impl Transform {
         let order = order.min(tay::MAX_ORDER);
         for k in 0..order {
             self.order(&mut e, numbers, k);
-            let ik = 1.0 / (k + 1) as f64;
+            let ik = tay::RECIPROCALS[k + 1];
             for i in 0..v.len() {
                 e.q[i][k + 1] = e.v[i][k] * ik;
                 e.v[i][k + 1] = self.output(&e, numbers, i, k) * ik;

@@ -88,19 +88,23 @@ impl Plan {
     /// [`Taylor::step`].
     pub fn step<const N: usize>(&self, s: &Series<N>) -> f64 {
         let p = s.order;
-        let norm = |j: usize| {
-            let mut m: f64 = 0.0;
-            for i in 0..N {
-                m = m.max(libm::fabs(s.q[i][j])).max(libm::fabs(s.v[i][j]));
+        // ‖x₀‖∞, ‖x_{p−1}‖∞ and ‖xₚ‖∞ in one pass; a NaN is passed over
+        // (the state evaluated on the step catches it).
+        let mut norms = [0.0f64; 3];
+        for i in 0..N {
+            for (m, j) in norms.iter_mut().zip([0, p - 1, p]) {
+                for x in [libm::fabs(s.q[i][j]), libm::fabs(s.v[i][j])] {
+                    if x > *m {
+                        *m = x;
+                    }
+                }
             }
-            m
-        };
-        let scale = norm(0).max(1.0);
+        }
+        let scale = norms[0].max(1.0);
         let log_eps = self.log_tolerance;
         // In logarithms: ln h = ln ρⱼ + min(ln ε / j, −2) − 0.7/(p − 1),
         // a logarithm per order read and one exponential per step.
-        let log_step = |j: usize| {
-            let x = norm(j);
+        let log_step = |j: usize, x: f64| {
             if x == 0.0 {
                 f64::INFINITY
             } else {
@@ -108,7 +112,7 @@ impl Plan {
                 libm::log(scale / x) / j + (log_eps / j).min(-2.0)
             }
         };
-        let log_h = log_step(p - 1).min(log_step(p));
+        let log_h = log_step(p - 1, norms[1]).min(log_step(p, norms[2]));
         if log_h == f64::INFINITY {
             return self.method.max_step;
         }
