@@ -167,3 +167,45 @@ fn the_counter_sees_allocations() {
     });
     assert!(n >= 1);
 }
+
+/// A model file run by the interpreter (`dalembert simulate FILE`): once
+/// its buffers are sized by a first call, the Taylor series of the motion
+/// and of each wall allocate nothing, and neither does a whole run of
+/// Taylor's method through collisions.
+#[test]
+fn interpreted_series_do_not_allocate() {
+    use dalembert::runtime::simulate::{Integrator, Settings, Simulator, State, Taylor};
+    use dalembert::runtime::taylor::{CAPACITY, Series};
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/ball_bounce.toml");
+    let d = dalembert_codegen::derive(&file).unwrap();
+    let ball = dalembert_codegen::interpret::Interpreted::<6>::new(&d).unwrap();
+    let start = State {
+        t: 0.0,
+        q: ball.initial_coordinates(),
+        v: ball.initial_velocities(),
+    };
+    let series = || {
+        let mut s = Series::at(&start.q, &start.v);
+        assert!(ball.taylor_series(&mut s, 20));
+        let mut f = [0.0; CAPACITY];
+        for &w in ball.walls() {
+            assert!(ball.surface_series(w, &s, &mut f));
+        }
+        f[2]
+    };
+    let first = series();
+    let mut again = 0.0;
+    assert_eq!(allocations_during(|| again = series()), 0);
+    assert_eq!(first, again);
+    let taylor = Settings {
+        integrator: Integrator::Taylor(Taylor::default()),
+        ..Settings::default()
+    };
+    let mut collisions = 0;
+    let n = allocations_during(|| {
+        let mut sim = Simulator::new(&ball, start, taylor).unwrap();
+        collisions = sim.run(5.0, |_| true).unwrap().collisions;
+    });
+    assert!(collisions >= 10, "{collisions} bounces");
+    assert_eq!(n, 0, "the interpreted run allocated {n} times");
+}

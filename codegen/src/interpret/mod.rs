@@ -124,6 +124,9 @@ pub struct Interpreted<const N: usize> {
 struct SeriesPrograms {
     motion: (Transform, Vec<f64>),
     walls: Vec<(Transform, Vec<f64>)>,
+    /// The coefficients of one evaluation, reused by every call (a step
+    /// of Taylor's method allocates nothing once it has run).
+    workspace: RefCell<Evaluation>,
 }
 
 impl SeriesPrograms {
@@ -135,6 +138,7 @@ impl SeriesPrograms {
         Self {
             motion: with_numbers(motion),
             walls: walls.into_iter().map(with_numbers).collect(),
+            workspace: RefCell::default(),
         }
     }
 
@@ -447,7 +451,8 @@ impl<const N: usize> Dynamics<N> for Interpreted<N> {
         let v: [f64; N] = std::array::from_fn(|i| series.v[i][0]);
         let order = order.min(MAX_ORDER);
         let (motion, numbers) = &sp.motion;
-        let e = motion.motion(numbers, &q, &v, order);
+        let e = &mut *sp.workspace.borrow_mut();
+        motion.motion_into(e, numbers, &q, &v, order);
         for i in 0..N {
             series.q[i] = e.q[i];
             series.v[i] = e.v[i];
@@ -465,15 +470,18 @@ impl<const N: usize> Surfaces<N> for Interpreted<N> {
         Some(self.scalar(&self.wall(wall).surface_hessian, q, v))
     }
     fn surface_series(&self, wall: WallIndex, series: &Series<N>, out: &mut Coefficients) -> bool {
-        let Some((t, numbers)) = self.series.as_ref().and_then(|s| s.walls.get(wall.0)) else {
+        let Some(sp) = &self.series else {
             return false;
         };
-        let mut e = Evaluation {
-            q: series.q.to_vec(),
-            v: series.v.to_vec(),
-            temps: Vec::new(),
+        let Some((t, numbers)) = sp.walls.get(wall.0) else {
+            return false;
         };
-        *out = t.along(numbers, &mut e, series.order);
+        let e = &mut *sp.workspace.borrow_mut();
+        e.q.clear();
+        e.q.extend_from_slice(&series.q);
+        e.v.clear();
+        e.v.extend_from_slice(&series.v);
+        *out = t.along(numbers, e, series.order);
         true
     }
 }

@@ -10,7 +10,10 @@ use super::{Op, Series, Term, Transform};
 use crate::program::{Instr, Program, Slot};
 
 /// The series state of an evaluation: coordinates, velocities, temporaries.
-#[derive(Clone, Debug)]
+/// Reusable: an evaluation reads only coefficients it wrote in the same
+/// run, so a buffer used before needs no clearing, and one large enough
+/// needs no allocation.
+#[derive(Clone, Debug, Default)]
 pub struct Evaluation {
     /// Coefficients of each coordinate.
     pub q: Vec<Coefficients>,
@@ -58,15 +61,18 @@ impl Transform {
     /// Runs order k of every op on `e` (coefficients below k in place).
     pub fn order(&self, e: &mut Evaluation, numbers: &[f64], k: usize) {
         for op in &self.ops {
-            let get = |s: Series| match s {
-                Series::Q(i) => e.q[i],
-                Series::V(i) => e.v[i],
-                Series::Temp(i) => e.temps[i],
+            // Operands by reference: a copy would move 256 bytes per operand.
+            let get = |s: Series| -> &Coefficients {
+                match s {
+                    Series::Q(i) => &e.q[i],
+                    Series::V(i) => &e.v[i],
+                    Series::Temp(i) => &e.temps[i],
+                }
             };
             let slot_value = |s: &Slot| numbers[self.number_index(*s)];
             let value = match op {
                 Op::SinCos { sin, cos, a } => {
-                    let (s, c) = tay::sin_cos(&get(*sin), &get(*cos), &get(*a), k);
+                    let (s, c) = tay::sin_cos(get(*sin), get(*cos), get(*a), k);
                     let (Series::Temp(si), Series::Temp(ci)) = (sin, cos) else {
                         unreachable!("pairs write temporaries")
                     };
@@ -84,16 +90,16 @@ impl Transform {
                     x
                 }
                 Op::Scale { a, by, .. } => get(*a)[k] * slot_value(by),
-                Op::Mul { a, b, .. } => tay::mul(&get(*a), &get(*b), k),
-                Op::Square { a, .. } => tay::square(&get(*a), k),
-                Op::Recip { dst, a } => tay::recip(&get(*dst), &get(*a), k),
-                Op::Sqrt { dst, a } => tay::sqrt(&get(*dst), &get(*a), k),
-                Op::Power { dst, a, alpha } => tay::power(&get(*dst), &get(*a), *alpha, k),
-                Op::Exp { dst, a } => tay::exp(&get(*dst), &get(*a), k),
-                Op::Log { dst, a } => tay::log(&get(*dst), &get(*a), k),
+                Op::Mul { a, b, .. } => tay::mul(get(*a), get(*b), k),
+                Op::Square { a, .. } => tay::square(get(*a), k),
+                Op::Recip { dst, a } => tay::recip(get(*dst), get(*a), k),
+                Op::Sqrt { dst, a } => tay::sqrt(get(*dst), get(*a), k),
+                Op::Power { dst, a, alpha } => tay::power(get(*dst), get(*a), *alpha, k),
+                Op::Exp { dst, a } => tay::exp(get(*dst), get(*a), k),
+                Op::Log { dst, a } => tay::log(get(*dst), get(*a), k),
             };
-            let Series::Temp(d) = op.writes()[0] else {
-                unreachable!("ops write temporaries")
+            let Some(Series::Temp(d)) = op.dst() else {
+                unreachable!("ops other than sin/cos write one temporary")
             };
             e.temps[d][k] = value;
         }
@@ -114,11 +120,24 @@ impl Transform {
     /// (q, v), to `order` (for tests and the interpreter; emitted code does
     /// the same in straight-line Rust).
     pub fn motion(&self, numbers: &[f64], q: &[f64], v: &[f64], order: usize) -> Evaluation {
-        let mut e = Evaluation {
-            q: vec![[0.0; tay::CAPACITY]; q.len()],
-            v: vec![[0.0; tay::CAPACITY]; v.len()],
-            temps: vec![[0.0; tay::CAPACITY]; self.temps],
-        };
+        let mut e = Evaluation::default();
+        self.motion_into(&mut e, numbers, q, v, order);
+        e
+    }
+
+    /// [`Transform::motion`] into `e`, reused (no allocation once it has
+    /// held an evaluation of this size).
+    pub fn motion_into(
+        &self,
+        e: &mut Evaluation,
+        numbers: &[f64],
+        q: &[f64],
+        v: &[f64],
+        order: usize,
+    ) {
+        e.q.resize(q.len(), [0.0; tay::CAPACITY]);
+        e.v.resize(v.len(), [0.0; tay::CAPACITY]);
+        e.temps.resize(self.temps, [0.0; tay::CAPACITY]);
         for (c, x) in e.q.iter_mut().zip(q) {
             c[0] = *x;
         }
@@ -127,20 +146,19 @@ impl Transform {
         }
         let order = order.min(tay::MAX_ORDER);
         for k in 0..order {
-            self.order(&mut e, numbers, k);
+            self.order(e, numbers, k);
             let ik = tay::RECIPROCALS[k + 1];
             for i in 0..v.len() {
                 e.q[i][k + 1] = e.v[i][k] * ik;
-                e.v[i][k + 1] = self.output(&e, numbers, i, k) * ik;
+                e.v[i][k + 1] = self.output(e, numbers, i, k) * ik;
             }
         }
-        e
     }
 
     /// The coefficients of the first output along the coordinates' series
     /// in `e` (its temporaries overwritten), orders 0 to `order`.
     pub fn along(&self, numbers: &[f64], e: &mut Evaluation, order: usize) -> Coefficients {
-        e.temps = vec![[0.0; tay::CAPACITY]; self.temps];
+        e.temps.resize(self.temps, [0.0; tay::CAPACITY]);
         let mut out = [0.0; tay::CAPACITY];
         for (k, o) in out
             .iter_mut()

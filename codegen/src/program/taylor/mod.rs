@@ -313,8 +313,17 @@ fn with_sources(ins: &Instr, dst: Slot, sources: &[Slot]) -> Instr {
 impl Op {
     /// What it writes (both halves for a sin/cos pair).
     pub fn writes(&self) -> Vec<Series> {
+        match (self, self.dst()) {
+            (Op::SinCos { sin, cos, .. }, _) => vec![*sin, *cos],
+            (_, dst) => dst.into_iter().collect(),
+        }
+    }
+
+    /// The one series this op writes; `None` for a sin/cos pair, which
+    /// writes two. (No allocation: the interpreter asks at every order.)
+    pub fn dst(&self) -> Option<Series> {
         match self {
-            Op::SinCos { sin, cos, .. } => vec![*sin, *cos],
+            Op::SinCos { .. } => None,
             Op::Add { dst, .. }
             | Op::Scale { dst, .. }
             | Op::Mul { dst, .. }
@@ -323,7 +332,7 @@ impl Op {
             | Op::Sqrt { dst, .. }
             | Op::Power { dst, .. }
             | Op::Exp { dst, .. }
-            | Op::Log { dst, .. } => vec![*dst],
+            | Op::Log { dst, .. } => Some(*dst),
         }
     }
 }
