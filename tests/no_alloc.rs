@@ -8,6 +8,7 @@ use dalembert::for_each_model;
 use dalembert::models::*;
 use dalembert::runtime::linalg::projector;
 use dalembert::runtime::prelude::*;
+use dalembert::runtime::simulate::{Settings, Simulator, State};
 
 struct Counting;
 
@@ -36,6 +37,22 @@ fn allocations_during(f: impl FnOnce()) -> usize {
     let before = ALLOCATIONS.with(Cell::get);
     f();
     ALLOCATIONS.with(Cell::get) - before
+}
+
+/// A simulation of `m` from `start` to `t_end`: the collisions met and the
+/// heap allocations made, from the simulator's construction on.
+fn simulated<M: Surfaces<N>, const N: usize>(
+    m: &M,
+    start: State<N>,
+    settings: Settings,
+    t_end: f64,
+) -> (u64, usize) {
+    let mut collisions = 0;
+    let n = allocations_during(|| {
+        let mut sim = Simulator::new(m, start, settings).unwrap();
+        collisions = sim.run(t_end, |_| true).unwrap().collisions;
+    });
+    (collisions, n)
 }
 
 /// Calls every function of the `Model` and `Walls` traits (and the
@@ -121,7 +138,7 @@ for_each_model!(no_alloc_test);
 /// projection) against its wall.
 #[test]
 fn simulator_does_not_allocate() {
-    use dalembert::runtime::simulate::{Integrator, Rk4, Settings, Simulator, State, Taylor};
+    use dalembert::runtime::simulate::{Integrator, Rk4, Taylor};
     let ball = BallBounce::default();
     let r = ball.params().r;
     let q = [0.0, 0.0, r + 1.0, 0.0, std::f64::consts::FRAC_PI_2, 0.0];
@@ -135,11 +152,7 @@ fn simulator_does_not_allocate() {
         ..Settings::default()
     };
     for settings in [Settings::default(), rk4, taylor] {
-        let mut collisions = 0;
-        let n = allocations_during(|| {
-            let mut sim = Simulator::new(&ball, State { t: 0.0, q, v }, settings).unwrap();
-            collisions = sim.run(20.0, |_| true).unwrap().collisions;
-        });
+        let (collisions, n) = simulated(&ball, State { t: 0.0, q, v }, settings, 20.0);
         assert!(collisions >= 20, "{collisions} bounces");
         assert_eq!(n, 0, "the simulator allocated {n} times");
         let pendulum = PendulumWall::default();
@@ -148,11 +161,7 @@ fn simulator_does_not_allocate() {
             q: [-0.8, -0.6],
             v: [0.0, 0.0],
         };
-        let mut hits = 0;
-        let n = allocations_during(|| {
-            let mut sim = Simulator::new(&pendulum, start, settings).unwrap();
-            hits = sim.run(10.0, |_| true).unwrap().collisions;
-        });
+        let (hits, n) = simulated(&pendulum, start, settings, 10.0);
         assert!(hits >= 5, "{hits} hits");
         assert_eq!(n, 0, "the simulator allocated {n} times");
     }
@@ -174,7 +183,7 @@ fn the_counter_sees_allocations() {
 /// Taylor's method through collisions.
 #[test]
 fn interpreted_series_do_not_allocate() {
-    use dalembert::runtime::simulate::{Integrator, Settings, Simulator, State, Taylor};
+    use dalembert::runtime::simulate::{Integrator, Taylor};
     use dalembert::runtime::taylor::{CAPACITY, Series};
     let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/ball_bounce.toml");
     let d = dalembert_codegen::derive(&file).unwrap();
@@ -201,11 +210,7 @@ fn interpreted_series_do_not_allocate() {
         integrator: Integrator::Taylor(Taylor::default()),
         ..Settings::default()
     };
-    let mut collisions = 0;
-    let n = allocations_during(|| {
-        let mut sim = Simulator::new(&ball, start, taylor).unwrap();
-        collisions = sim.run(5.0, |_| true).unwrap().collisions;
-    });
+    let (collisions, n) = simulated(&ball, start, taylor, 5.0);
     assert!(collisions >= 10, "{collisions} bounces");
     assert_eq!(n, 0, "the interpreted run allocated {n} times");
 }

@@ -286,13 +286,12 @@ fn root(c: &Coefficients, order: usize, mut a: f64, mut b: f64) -> f64 {
         return b;
     }
     let above_at_a = fa > 0.0;
-    let mut x = match (order <= 2)
-        .then(|| quadratic_root(c, order, a, b))
-        .flatten()
-    {
-        Some(x) => x,
-        None => a - fa * (b - a) / (fb - fa),
+    let closed_form = if order <= 2 {
+        quadratic_root(c, order, a, b)
+    } else {
+        None
     };
+    let mut x = closed_form.unwrap_or_else(|| a - fa * (b - a) / (fb - fa));
     if !(x > a && x < b) {
         x = 0.5 * (a + b);
     }
@@ -320,10 +319,11 @@ fn root(c: &Coefficients, order: usize, mut a: f64, mut b: f64) -> f64 {
     x
 }
 
-/// A root of c₀ + c₁τ + c₂τ² (the polynomial of `order` ≤ 2) in (a, b), by the formula that loses no
-/// digits to cancellation (the larger root from −(c₁ + sign(c₁)√d)/2, the
-/// other from the product of the roots); `None` where no root is found
-/// there (a rounding-level discriminant, or a root just outside).
+/// A root of c₀ + c₁τ + c₂τ² (the polynomial of `order` ≤ 2) in (a, b),
+/// by the formula that loses no digits to cancellation (the larger root
+/// from −(c₁ + sign(c₁)√d)/2, the other from the product of the roots);
+/// `None` where no root is found there (a rounding-level discriminant, or a
+/// root just outside).
 fn quadratic_root(c: &Coefficients, order: usize, a: f64, b: f64) -> Option<f64> {
     let coefficient = |k: usize| if k <= order { c[k] } else { 0.0 };
     let (c0, c1, c2) = (c[0], coefficient(1), coefficient(2));

@@ -313,9 +313,9 @@ fn with_sources(ins: &Instr, dst: Slot, sources: &[Slot]) -> Instr {
 impl Op {
     /// What it writes (both halves for a sin/cos pair).
     pub fn writes(&self) -> Vec<Series> {
-        match (self, self.dst()) {
-            (Op::SinCos { sin, cos, .. }, _) => vec![*sin, *cos],
-            (_, dst) => dst.into_iter().collect(),
+        match self {
+            Op::SinCos { sin, cos, .. } => vec![*sin, *cos],
+            _ => self.dst().into_iter().collect(),
         }
     }
 
