@@ -14,7 +14,7 @@ use super::symbols::Symbols;
 use super::{Field, Rat, is_zero, rows_matrix, strings};
 use crate::diag::{Collector, ErrorKind, Reported};
 use crate::ir::{Kind, Wall};
-use crate::program::Entry;
+use crate::program::{Entry, stored_signs};
 use crate::quantity::Quantity;
 
 /// What every wall shares: the model's symbols, lowering, exact G and A,
@@ -336,15 +336,18 @@ fn admissible_collision(
 }
 
 /// Operations per call of one row of a linear map: a multiplication per
-/// entry that is not 0 or ±1, a negation per −1, an addition per further
-/// term.
+/// entry that is not 0 or ±1, an addition or subtraction per further term,
+/// and a negation where every term is subtracted (all entries −1).
 fn row_cost(row: &[Atom]) -> usize {
     let terms = row.iter().filter(|x| !is_zero(x)).count();
-    let ones = row
-        .iter()
-        .filter(|x| is_zero(&((*x).clone() - Atom::num(1))))
-        .count();
-    (terms - ones) + terms.saturating_sub(1)
+    let ones = |sign: i64| {
+        row.iter()
+            .filter(|x| is_zero(&((*x).clone() - Atom::num(sign))))
+            .count()
+    };
+    let (plus, minus) = (ones(1), ones(-1));
+    let negation = usize::from(terms > 0 && minus == terms);
+    (terms - plus - minus) + terms.saturating_sub(1) + negation
 }
 
 /// The entries of a rows × cols matrix, simplified.
@@ -392,9 +395,11 @@ fn subsets(n: usize, k: usize) -> Vec<Vec<usize>> {
     }
 }
 
-/// v⁺ = M v as a function: M's entries that are not 0 or ±1 are the
-/// program's (parameter-only) outputs, one multiplication each per call;
-/// the rows `over_outputs` multiply v⁺ (the other rows) instead of v.
+/// v⁺ = M v as a function: M's entries that are not 0 or ±1 are, up to
+/// sign, the program's (parameter-only) outputs, each distinct value once
+/// with the signs that need no negation (`stored_signs`); one
+/// multiplication per entry per call. The rows `over_outputs` multiply v⁺ (the other rows)
+/// instead of v.
 fn linear_map(
     c: &Context,
     cx: &mut Collector,
@@ -404,8 +409,10 @@ fn linear_map(
 ) -> Result<Option<Function>, Reported> {
     let sym = c.sym;
     let n = sym.vels.len();
+    // Each entry that is not 0 or ±1 is ± one of the distinct values, kept
+    // once each whatever its sign.
     let mut entries = Vec::with_capacity(n * n);
-    let mut general = Vec::new();
+    let mut values: Vec<Atom> = Vec::new();
     for m in m.iter().flatten() {
         entries.push(if is_zero(m) {
             Entry::Zero
@@ -413,11 +420,28 @@ fn linear_map(
             Entry::One
         } else if is_zero(&(m.clone() + Atom::num(1))) {
             Entry::MinusOne
+        } else if let Some(k) = values.iter().position(|g| is_zero(&(m.clone() - g))) {
+            Entry::Value { k, negated: false }
+        } else if let Some(k) = values.iter().position(|g| is_zero(&(m.clone() + g))) {
+            Entry::Value { k, negated: true }
         } else {
-            general.push(m.clone());
-            Entry::General
+            values.push(m.clone());
+            Entry::Value {
+                k: values.len() - 1,
+                negated: false,
+            }
         });
     }
+    let general: Vec<Atom> = stored_signs(&mut entries, n, values.len())
+        .into_iter()
+        .map(|(k, negated)| {
+            if negated {
+                -values[k].clone()
+            } else {
+                values[k].clone()
+            }
+        })
+        .collect();
     let Some(f) = c
         .compile
         .applicable(cx, Quantity::Collide, &general, 0, span)?

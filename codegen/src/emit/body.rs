@@ -198,6 +198,7 @@ pub(super) fn slot(d: &Ctx, p: &Program, s: Slot) -> TokenStream {
 fn instr(d: &Ctx, p: &Program, ins: &Instr) -> TokenStream {
     let (dst, value) = match ins {
         Instr::Add(o, s) => (*o, join(s.iter().map(|&x| slot(d, p, x)), quote! { + })),
+        Instr::Sub(o, s) => (*o, join(s.iter().map(|&x| slot(d, p, x)), quote! { - })),
         Instr::Mul(o, s) => (*o, product(d, p, None, s)),
         Instr::Pow(o, s, n) => (*o, pow(d, slot(d, p, *s), *n)),
         Instr::Powf(o, s, x) => (*o, powf(d, slot(d, p, *s), *x)),

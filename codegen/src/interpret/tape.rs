@@ -24,6 +24,8 @@ use crate::program::{Func, Instr, Program, Slot};
 enum Kind {
     /// a + b
     Add,
+    /// a − b
+    Sub,
     /// Σ of `b` registers listed in `args` from `a`, left to right.
     Sum,
     /// a · b
@@ -161,6 +163,10 @@ impl Builder {
             Instr::Add(_, s) => {
                 let s: Vec<u32> = s.iter().map(|&x| self.read(x)).collect();
                 self.nary(&s, Kind::Add, Kind::Sum)
+            }
+            Instr::Sub(_, [x, y]) => {
+                let (a, b) = (self.read(*x), self.read(*y));
+                self.push(Kind::Sub, a, b, &[a, b])
             }
             Instr::Mul(_, s) => {
                 // As emitted: factors −1 dropped, the product negated when
@@ -313,6 +319,7 @@ impl Tape {
             }
             match run.kind {
                 Kind::Add => each!(|o| r[at(o.d)] = r[at(o.a)] + r[at(o.b)]),
+                Kind::Sub => each!(|o| r[at(o.d)] = r[at(o.a)] - r[at(o.b)]),
                 Kind::Mul => each!(|o| r[at(o.d)] = r[at(o.a)] * r[at(o.b)]),
                 Kind::Sum => each!(|o| {
                     let args = &self.args[at(o.a)..at(o.a) + at(o.b)];
@@ -375,7 +382,7 @@ mod tests {
     }
 
     /// Each instruction computes what the emitted code computes, bit for
-    /// bit: sums and products left to right, −1 factors as a negation,
+    /// bit: sums and products left to right, a difference, −1 factors as a negation,
     /// small powers as products, large and negative ones through pow and a
     /// reciprocal, ±½ powers as square roots, sin and cos of one value by
     /// one sincos; a temporary written twice holds each value in turn.
@@ -400,8 +407,9 @@ mod tests {
                 Instr::Fun(Slot::Out(8), Func::Cos, x),
                 Instr::Add(t0, vec![t0, t1]),
                 Instr::Mul(Slot::Out(9), vec![t0, t0]),
+                Instr::Sub(Slot::Out(11), [y, t1]),
             ],
-            outputs: 11,
+            outputs: 12,
         };
         let (a, b) = (0.7312_f64, 2.25_f64);
         let got = run(&p, &[a, b]);
@@ -419,6 +427,7 @@ mod tests {
             cos,
             (s + sin) * (s + sin),
             0.0,
+            b - sin,
         ];
         for (g, w) in got.iter().zip(want) {
             assert_eq!(g.to_bits(), w.to_bits(), "{got:?} vs {want:?}");

@@ -14,7 +14,7 @@ use std::collections::HashMap;
 
 pub use elimination::Layout;
 pub use hoist::{Emit, Role, Split};
-pub use linear::Entry;
+pub use linear::{Entry, stored_signs};
 pub use taylor::{Evaluation, Op, Series, Term, Transform};
 
 /// Where a value lives.
@@ -86,6 +86,9 @@ impl Func {
 pub enum Instr {
     /// dst = Σ srcs
     Add(Slot, Vec<Slot>),
+    /// dst = a − b (a linear map's terms of opposite signs, so that a
+    /// value and its negation can share one slot)
+    Sub(Slot, [Slot; 2]),
     /// dst = Π srcs
     Mul(Slot, Vec<Slot>),
     /// dst = src^n
@@ -103,6 +106,7 @@ impl Instr {
     pub fn dst(&self) -> Slot {
         match self {
             Self::Add(o, _)
+            | Self::Sub(o, _)
             | Self::Mul(o, _)
             | Self::Pow(o, _, _)
             | Self::Powf(o, _, _)
@@ -115,6 +119,7 @@ impl Instr {
     pub fn sources(&self) -> &[Slot] {
         match self {
             Self::Add(_, s) | Self::Mul(_, s) => s,
+            Self::Sub(_, s) => s,
             Self::Pow(_, s, _) | Self::Powf(_, s, _) | Self::Fun(_, _, s) | Self::Assign(_, s) => {
                 core::slice::from_ref(s)
             }
@@ -128,6 +133,7 @@ impl Instr {
         let all = |s: &[Slot]| s.iter().map(|&x| f(x)).collect();
         match self {
             Instr::Add(d, s) => Instr::Add(f(*d), all(s)),
+            Instr::Sub(d, [a, b]) => Instr::Sub(f(*d), [f(*a), f(*b)]),
             Instr::Mul(d, s) => Instr::Mul(f(*d), all(s)),
             Instr::Pow(d, s, n) => Instr::Pow(f(*d), f(*s), *n),
             Instr::Powf(d, s, x) => Instr::Powf(f(*d), f(*s), *x),
@@ -246,6 +252,7 @@ impl Program {
         for ins in &self.instrs {
             let (dst, value) = match ins {
                 Instr::Add(d, s) => (*d, s.iter().map(|&x| get(x, &temps, &outs)).sum()),
+                Instr::Sub(d, [a, b]) => (*d, get(*a, &temps, &outs) - get(*b, &temps, &outs)),
                 Instr::Mul(d, s) => (*d, s.iter().map(|&x| get(x, &temps, &outs)).product()),
                 Instr::Pow(d, s, n) => (*d, get(*s, &temps, &outs).powi(*n as i32)),
                 Instr::Powf(d, s, x) => (*d, powf(get(*s, &temps, &outs), *x)),
@@ -314,7 +321,7 @@ impl Program {
         for (i, ins) in self.instrs.iter().enumerate() {
             let Some(k) = operands(i, ins) else { continue };
             match ins {
-                Instr::Add(..) => c.add += k.saturating_sub(1),
+                Instr::Add(..) | Instr::Sub(..) => c.add += k.saturating_sub(1),
                 Instr::Mul(..) => c.mul += k.saturating_sub(1),
                 Instr::Pow(_, _, n) => {
                     c.mul += (n.unsigned_abs() as usize).saturating_sub(1);

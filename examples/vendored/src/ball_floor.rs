@@ -16,8 +16,8 @@
 //   floor_projector              0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_collide                4 add, 9 mul, 0 div, 0 fn (13 in all)
 //
-// Parameter-only work, done once when the parameters are set (13 values kept):
-//   all functions                4 add, 23 mul, 2 div, 0 fn (29 in all)
+// Parameter-only work, done once when the parameters are set (11 values kept):
+//   all functions                3 add, 21 mul, 2 div, 0 fn (26 in all)
 //
 // Solves, the cheapest form per call (cost: add + mul + 4 div + 20 fn):
 //   floor_collide                M v, M = I - 2P kept with the parameters [linear 13, closed form 20, elimination 23]
@@ -59,7 +59,7 @@ pub struct BallFloor {
     /// `set_parameter`, which keep `pre` up to date).
     params: Params,
     /// The parameter-only values the functions read.
-    pre: [f64; 13],
+    pre: [f64; 11],
 }
 impl Default for BallFloor {
     /// The model with the model file's parameter values.
@@ -114,8 +114,8 @@ impl BallFloor {
     }
     /// The parameter-only values the functions read, from `params`.
     #[allow(unused_variables, unused_mut, clippy::approx_constant)]
-    fn precompute(params: &Params) -> [f64; 13] {
-        let mut pre: [f64; 13] = [0.0; 13];
+    fn precompute(params: &Params) -> [f64; 11] {
+        let mut pre: [f64; 11] = [0.0; 11];
         {
             let i1: f64 = params.r;
             let o10: f64 = -(i1);
@@ -150,29 +150,21 @@ impl BallFloor {
             let i0: f64 = params.m;
             let i1: f64 = params.r;
             let i2: f64 = params.J;
-            let t8: f64 = i1 * i1;
-            let t8: f64 = i0 * t8;
-            let t1: f64 = i2 + t8;
-            let t1: f64 = 1.0 / (t1);
-            let t7: f64 = -2f64 * t1;
-            let t5: f64 = i2 * t7;
-            let t2: f64 = 1f64 + t5;
-            pre[7] = t2;
-            let t1: f64 = i1 * t1;
-            let t1: f64 = 2f64 * t1;
-            let t3: f64 = i2 * t1;
-            pre[8] = t3;
-            let t5: f64 = i1 * t5;
-            pre[9] = t5;
-            let t6: f64 = i0 * i1 * t7;
-            pre[10] = t6;
-            let t8: f64 = t8 * t7;
-            let t7: f64 = 1f64 + t8;
-            pre[11] = t7;
-            let t8: f64 = i0 * t1;
-            pre[12] = t8;
-            let t4: f64 = t2;
-            let t9: f64 = t7;
+            let t2: f64 = i1 * i1;
+            let t2: f64 = i0 * t2;
+            let t2: f64 = i2 + t2;
+            let t2: f64 = 1.0 / (t2);
+            let t0: f64 = i2 * -2f64 * t2;
+            let t0: f64 = 1f64 + t0;
+            pre[7] = t0;
+            let t2: f64 = i1 * t2;
+            let t3: f64 = 2f64 * t2;
+            let t1: f64 = i2 * t3;
+            pre[8] = t1;
+            let t2: f64 = i0 * -2f64 * t2;
+            pre[9] = t2;
+            let t3: f64 = i0 * t3;
+            pre[10] = t3;
         }
         pre
     }
@@ -383,28 +375,23 @@ impl BallFloor {
         let i6: f64 = v[3];
         let i7: f64 = v[4];
         let i8: f64 = v[5];
-        let t2: f64 = self.pre[7];
-        let t3: f64 = self.pre[8];
-        let t5: f64 = self.pre[9];
-        let t6: f64 = self.pre[10];
-        let t7: f64 = self.pre[11];
-        let t8: f64 = self.pre[12];
-        let t4: f64 = self.pre[7];
-        let t9: f64 = self.pre[11];
-        let t10: f64 = t2 * i3;
-        let t11: f64 = t3 * i7;
-        let o0: f64 = t10 + t11;
-        let t12: f64 = t4 * i4;
-        let t13: f64 = t5 * i6;
-        let o1: f64 = t12 + t13;
-        let t14: f64 = -(i5);
-        let o2: f64 = t14;
-        let t15: f64 = t6 * i4;
-        let t16: f64 = t7 * i6;
-        let o3: f64 = t15 + t16;
-        let t17: f64 = t8 * i3;
-        let t18: f64 = t9 * i7;
-        let o4: f64 = t17 + t18;
+        let t0: f64 = self.pre[7];
+        let t1: f64 = self.pre[8];
+        let t2: f64 = self.pre[9];
+        let t3: f64 = self.pre[10];
+        let t4: f64 = t0 * i3;
+        let t5: f64 = t1 * i7;
+        let o0: f64 = t4 + t5;
+        let t7: f64 = t0 * i4;
+        let t8: f64 = t1 * i6;
+        let o1: f64 = t7 - t8;
+        let o2: f64 = -(i5);
+        let t11: f64 = t2 * i4;
+        let t12: f64 = t0 * i6;
+        let o3: f64 = t11 - t12;
+        let t14: f64 = t3 * i3;
+        let t15: f64 = t0 * i7;
+        let o4: f64 = t14 - t15;
         let o5: f64 = i8;
         [o0, o1, o2, o3, o4, o5]
     }

@@ -199,20 +199,12 @@ impl<'a> Builder<'a> {
         };
         match ins {
             Instr::Assign(_, _) => terms[0],
-            Instr::Add(_, _) => {
-                let mut series = Vec::new();
-                let mut numbers = Vec::new();
-                for t in &terms {
-                    match t {
-                        Term::Series(s) => series.push(*s),
-                        Term::Number(n) => numbers.push(*n),
-                    }
-                }
-                Term::Series(self.op(|dst| Op::Add {
-                    dst,
-                    series,
-                    numbers,
-                }))
+            Instr::Add(_, _) => self.sum(&terms),
+            Instr::Sub(_, _) => {
+                // a − b as a + (−1)·b.
+                let minus_one = Term::Number(constant(&mut self.numbers.consts, -1.0));
+                let b = self.times(terms[1], minus_one);
+                self.sum(&[terms[0], b])
             }
             Instr::Mul(_, _) => {
                 let mut acc = terms[0];
@@ -281,6 +273,23 @@ impl<'a> Builder<'a> {
         }
     }
 
+    /// Σ terms, at least one of them a series.
+    fn sum(&mut self, terms: &[Term]) -> Term {
+        let mut series = Vec::new();
+        let mut numbers = Vec::new();
+        for t in terms {
+            match t {
+                Term::Series(s) => series.push(*s),
+                Term::Number(n) => numbers.push(*n),
+            }
+        }
+        Term::Series(self.op(|dst| Op::Add {
+            dst,
+            series,
+            numbers,
+        }))
+    }
+
     /// a·b, where at least one is a series or both are numbers.
     fn times(&mut self, a: Term, b: Term) -> Term {
         match (a, b) {
@@ -302,6 +311,7 @@ impl<'a> Builder<'a> {
 fn with_sources(ins: &Instr, dst: Slot, sources: &[Slot]) -> Instr {
     match ins {
         Instr::Add(..) => Instr::Add(dst, sources.to_vec()),
+        Instr::Sub(..) => Instr::Sub(dst, [sources[0], sources[1]]),
         Instr::Mul(..) => Instr::Mul(dst, sources.to_vec()),
         Instr::Pow(_, _, n) => Instr::Pow(dst, sources[0], *n),
         Instr::Powf(_, _, x) => Instr::Powf(dst, sources[0], *x),
@@ -436,7 +446,7 @@ mod tests {
     }
 
     /// Every kind of instruction: the transform of
-    /// o = exp(x)·log(x)·x^-2 + sqrt(x) + x^1.5 + x^10 + 1/sqrt(x) + cos(x)
+    /// o = exp(x)·log(x)·x^-2 + sqrt(x) + x^1.5 + x^10 + 1/sqrt(x) − cos(x)
     /// along x(t) = 2 + t agrees with its values at a few points of t.
     #[test]
     fn every_instruction_along_a_line() {
@@ -455,17 +465,14 @@ mod tests {
                 Instr::Pow(t(6), x, 10),
                 Instr::Powf(t(7), x, -0.5),
                 Instr::Fun(t(8), Func::Cos, x),
-                Instr::Add(Slot::Out(0), vec![t(3), t(4), t(5), t(6), t(7), t(8)]),
+                Instr::Add(t(9), vec![t(3), t(4), t(5), t(6), t(7)]),
+                Instr::Sub(Slot::Out(0), [t(9), t(8)]),
             ],
             outputs: 1,
         };
         let f = |x: f64| {
-            x.exp() * x.ln() / (x * x)
-                + x.sqrt()
-                + x.powf(1.5)
-                + x.powi(10)
-                + 1.0 / x.sqrt()
-                + x.cos()
+            x.exp() * x.ln() / (x * x) + x.sqrt() + x.powf(1.5) + x.powi(10) + 1.0 / x.sqrt()
+                - x.cos()
         };
         // inputs: one parameter (unused), then the coordinate x.
         let tr = p.taylor(1, 1);
