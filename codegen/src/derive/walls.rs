@@ -398,8 +398,8 @@ fn subsets(n: usize, k: usize) -> Vec<Vec<usize>> {
 /// v⁺ = M v as a function: M's entries that are not 0 or ±1 are, up to
 /// sign, the program's (parameter-only) outputs, each distinct value once
 /// with the signs that need no negation (`stored_signs`); one
-/// multiplication per entry per call. The rows `over_outputs` multiply v⁺ (the other rows)
-/// instead of v.
+/// multiplication per entry per call. The rows `over_outputs` multiply v⁺
+/// (the other rows) instead of v.
 fn linear_map(
     c: &Context,
     cx: &mut Collector,

@@ -139,7 +139,8 @@ fn operation(
             let rest = operands.iter().map(|&x| slot(d, p, x));
             join(first.into_iter().chain(rest), quote! { + })
         }
-        _ => product(d, p, first, operands),
+        Instr::Mul(..) => product(d, p, first, operands),
+        _ => unreachable!("only sums and products are split at leading operands"),
     }
 }
 
