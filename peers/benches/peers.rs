@@ -125,22 +125,6 @@ fn section_3_2(c: &mut Criterion<ThreadCpuTime>) {
     );
 }
 
-/// The chain's masses and lengths, by name from the model.
-fn masses_and_lengths<M: Model<N, N>, const N: usize>(m: &M) -> ([f64; N], [f64; N]) {
-    let value = |name: String| {
-        let i = m
-            .parameter_names()
-            .iter()
-            .position(|p| *p == name)
-            .unwrap_or_else(|| panic!("{} has no parameter {name}", m.name()));
-        m.parameter(i).expect("in range")
-    };
-    (
-        std::array::from_fn(|k| value(format!("m{}", k + 1))),
-        std::array::from_fn(|k| value(format!("l{}", k + 1))),
-    )
-}
-
 fn chain<M: Surfaces<N> + Default, const N: usize>(g: &mut BenchmarkGroup<'_, ThreadCpuTime>) {
     let model = M::default();
     let q = model.initial_coordinates();

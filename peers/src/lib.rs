@@ -160,3 +160,22 @@ pub fn casadi_chain<const N: usize>(
     let f = ffi::casadi_chain(N).expect("chains of 1 to 8 links are generated");
     casadi(f, &[q.as_ptr(), v.as_ptr(), m.as_ptr(), l.as_ptr()])
 }
+
+/// A chain model's masses m1.. and lengths l1.., read by name from its
+/// parameters (the peers' functions take them as arrays).
+pub fn masses_and_lengths<M: dalembert::runtime::Model<N, N>, const N: usize>(
+    m: &M,
+) -> ([f64; N], [f64; N]) {
+    let value = |name: String| {
+        let i = m
+            .parameter_names()
+            .iter()
+            .position(|p| *p == name)
+            .unwrap_or_else(|| panic!("{} has no parameter {name}", m.name()));
+        m.parameter(i).expect("in range")
+    };
+    (
+        std::array::from_fn(|k| value(format!("m{}", k + 1))),
+        std::array::from_fn(|k| value(format!("l{}", k + 1))),
+    )
+}
