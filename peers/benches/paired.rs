@@ -35,18 +35,13 @@ use inputs::inputs;
 /// Chain n: generated against SymForce, over the velocities of
 /// `peers.rs`'s chain bench.
 fn chain<M: Surfaces<N> + Default, const N: usize>(rounds: usize) {
-    let model = M::default();
-    let q = model.initial_coordinates();
-    let (m, l) = masses_and_lengths(&model);
-    let wall = model.walls()[0];
-    let base: [f64; N] = std::array::from_fn(|i| 0.3 - 0.1 * i as f64);
-    let vs = inputs(|u: [f64; N]| std::array::from_fn(|i| base[i] + 0.5 * u[i]));
+    let c = Chain::<M, N>::new();
     pair(
-        &format!("{} generated / SymForce", model.name()),
+        &format!("{} generated / SymForce", c.model.name()),
         rounds,
-        &vs,
-        |v| black_box(&model).collide(wall, black_box(&q), v),
-        |v| symforce_chain(black_box(&q), v, black_box(&m), black_box(&l)),
+        &inputs(Chain::<M, N>::velocity),
+        |v| c.generated(v),
+        |v| c.symforce(v),
     );
 }
 

@@ -126,25 +126,19 @@ fn section_3_2(c: &mut Criterion<ThreadCpuTime>) {
 }
 
 fn chain<M: Surfaces<N> + Default, const N: usize>(g: &mut BenchmarkGroup<'_, ThreadCpuTime>) {
-    let model = M::default();
-    let q = model.initial_coordinates();
-    let (m, l) = masses_and_lengths(&model);
-    let wall = model.walls()[0];
-    // The chain bench's velocity (benches/collision.rs), and others around it.
-    let base: [f64; N] = std::array::from_fn(|i| 0.3 - 0.1 * i as f64);
-    let vs = inputs(|u: [f64; N]| std::array::from_fn(|i| base[i] + 0.5 * u[i]));
-    let generated = |v: &[f64; N]| black_box(&model).collide(wall, black_box(&q), v);
-    let symforce = |v: &[f64; N]| symforce_chain(black_box(&q), v, black_box(&m), black_box(&l));
-    let casadi = |v: &[f64; N]| casadi_chain(black_box(&q), v, black_box(&m), black_box(&l));
+    let c = Chain::<M, N>::new();
+    let vs = inputs(Chain::<M, N>::velocity);
+    let name = c.model.name();
+    let (symforce, casadi) = (|v: &[f64; N]| c.symforce(v), |v: &[f64; N]| c.casadi(v));
     agree(
-        model.name(),
+        name,
         &vs,
-        generated,
+        |v| c.generated(v),
         &[("symforce", &symforce), ("casadi", &casadi)],
     );
-    cycle(g, &format!("{}/generated", model.name()), &vs, generated);
-    cycle(g, &format!("{}/symforce", model.name()), &vs, symforce);
-    cycle(g, &format!("{}/casadi", model.name()), &vs, casadi);
+    cycle(g, &format!("{name}/generated"), &vs, |v| c.generated(v));
+    cycle(g, &format!("{name}/symforce"), &vs, symforce);
+    cycle(g, &format!("{name}/casadi"), &vs, casadi);
 }
 
 fn chains(c: &mut Criterion<ThreadCpuTime>) {

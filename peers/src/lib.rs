@@ -4,7 +4,10 @@
 //! tools' users would call them; each is a call through the C ABI (no
 //! inlining across the languages).
 
+use std::hint::black_box;
 use std::os::raw::c_int;
+
+use dalembert::runtime::prelude::*;
 
 mod ffi {
     use std::os::raw::c_int;
@@ -161,21 +164,79 @@ pub fn casadi_chain<const N: usize>(
     casadi(f, &[q.as_ptr(), v.as_ptr(), m.as_ptr(), l.as_ptr()])
 }
 
-/// A chain model's masses m1.. and lengths l1.., read by name from its
-/// parameters (the peers' functions take them as arrays).
-pub fn masses_and_lengths<M: dalembert::runtime::Model<N, N>, const N: usize>(
-    m: &M,
-) -> ([f64; N], [f64; N]) {
-    let value = |name: String| {
-        let i = m
-            .parameter_names()
-            .iter()
-            .position(|p| *p == name)
-            .unwrap_or_else(|| panic!("{} has no parameter {name}", m.name()));
-        m.parameter(i).expect("in range")
-    };
-    (
-        std::array::from_fn(|k| value(format!("m{}", k + 1))),
-        std::array::from_fn(|k| value(format!("l{}", k + 1))),
-    )
+/// The n-link chain as the peers benches take it: the model with the model
+/// file's parameters at its initial configuration, its masses and lengths
+/// as the peers' functions take them, and its wall; each way of computing
+/// the collision map at that configuration.
+pub struct Chain<M: Surfaces<N>, const N: usize> {
+    pub model: M,
+    pub q: [f64; N],
+    m: [f64; N],
+    l: [f64; N],
+    wall: M::Wall,
+}
+
+impl<M: Surfaces<N> + Default, const N: usize> Chain<M, N> {
+    pub fn new() -> Self {
+        let model = M::default();
+        let q = model.initial_coordinates();
+        let value = |name: String| {
+            let i = model
+                .parameter_names()
+                .iter()
+                .position(|p| *p == name)
+                .unwrap_or_else(|| panic!("{} has no parameter {name}", model.name()));
+            model.parameter(i).expect("in range")
+        };
+        let m = std::array::from_fn(|k| value(format!("m{}", k + 1)));
+        let l = std::array::from_fn(|k| value(format!("l{}", k + 1)));
+        let wall = model.walls()[0];
+        Self {
+            model,
+            q,
+            m,
+            l,
+            wall,
+        }
+    }
+
+    /// A velocity around the chain bench's (`benches/collision.rs`,
+    /// 0.3 − 0.1 i) from uniform numbers u in [−2, 2): 0.3 − 0.1 i + u/2.
+    pub fn velocity(u: [f64; N]) -> [f64; N] {
+        std::array::from_fn(|i| 0.3 - 0.1 * i as f64 + 0.5 * u[i])
+    }
+
+    /// v⁺ by the generated map (through `Walls::collide`).
+    #[inline]
+    pub fn generated(&self, v: &[f64; N]) -> [f64; N] {
+        black_box(&self.model).collide(self.wall, black_box(&self.q), v)
+    }
+
+    /// v⁺ by SymForce's code.
+    #[inline]
+    pub fn symforce(&self, v: &[f64; N]) -> [f64; N] {
+        symforce_chain(
+            black_box(&self.q),
+            v,
+            black_box(&self.m),
+            black_box(&self.l),
+        )
+    }
+
+    /// v⁺ by CasADi's code.
+    #[inline]
+    pub fn casadi(&self, v: &[f64; N]) -> [f64; N] {
+        casadi_chain(
+            black_box(&self.q),
+            v,
+            black_box(&self.m),
+            black_box(&self.l),
+        )
+    }
+}
+
+impl<M: Surfaces<N> + Default, const N: usize> Default for Chain<M, N> {
+    fn default() -> Self {
+        Self::new()
+    }
 }

@@ -382,10 +382,11 @@ mod tests {
     }
 
     /// Each instruction computes what the emitted code computes, bit for
-    /// bit: sums and products left to right, a difference, −1 factors as a negation,
-    /// small powers as products, large and negative ones through pow and a
-    /// reciprocal, ±½ powers as square roots, sin and cos of one value by
-    /// one sincos; a temporary written twice holds each value in turn.
+    /// bit: sums and products left to right, a difference, −1 factors as a
+    /// negation, small powers as products, large and negative ones through
+    /// pow and a reciprocal, ±½ powers as square roots, sin and cos of one
+    /// value by one sincos; a temporary written twice holds each value in
+    /// turn.
     #[test]
     fn instructions_match_the_emitted_arithmetic() {
         let (x, y) = (Slot::Input(0), Slot::Input(1));
