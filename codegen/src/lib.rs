@@ -116,10 +116,36 @@ pub struct Generated {
     pub n: usize,
 }
 
+/// Set in a process [`compile_dir`] starts for one model: the model file,
+/// and the file to write its code to.
+const ONE_MODEL: &str = "DALEMBERT_COMPILE_ONE_MODEL";
+const ONE_OUTPUT: &str = "DALEMBERT_COMPILE_ONE_OUTPUT";
+
 /// Generates every `*.toml` model in `models_dir` into `out_dir` (one file per
 /// model plus `models.rs`, which includes them all). Errors of every model are
 /// collected before returning.
+///
+/// Called from a build script (cargo has set `TARGET`, `HOST` and
+/// `OUT_DIR`), it derives each model in a process of its own: the build
+/// script runs again, once per model, and this call in it generates that
+/// model and exits, so call it before anything else the build script
+/// prints. symbolica's evaluator does not always give the same program for
+/// a model derived after others in one process as for the model alone
+/// (`ARCHITECTURE.md`); this way the build script's code is what
+/// `dalembert generate` writes. Elsewhere, or where a process cannot be
+/// started, and for a model whose process fails (to collect its errors),
+/// the model is derived in this process.
 pub fn compile_dir(models_dir: &Path, out_dir: &Path) -> Result<Vec<Generated>, Vec<ModelErrors>> {
+    if let (Some(model), Some(output)) = (std::env::var_os(ONE_MODEL), std::env::var_os(ONE_OUTPUT))
+    {
+        // The process started for one model.
+        let ok =
+            generate(Path::new(&model)).is_ok_and(|code| std::fs::write(&output, code).is_ok());
+        std::process::exit(if ok { 0 } else { 1 });
+    }
+    let build_script = ["TARGET", "HOST", "OUT_DIR"]
+        .iter()
+        .all(|v| std::env::var_os(v).is_some());
     let mut files: Vec<PathBuf> = match std::fs::read_dir(models_dir) {
         Ok(rd) => rd
             .filter_map(|e| e.ok().map(|e| e.path()))
@@ -134,7 +160,41 @@ pub fn compile_dir(models_dir: &Path, out_dir: &Path) -> Result<Vec<Generated>, 
     files.sort();
     let mut done = Vec::new();
     let mut errors = Vec::new();
+    // Models to derive here, after every process started for one has ended
+    // (this process holds symbolica's lock from its first derivation on).
+    let mut here = Vec::new();
     for file in files {
+        let model = match ir::load(&file) {
+            Ok(m) => m,
+            Err(e) => {
+                errors.push(e);
+                continue;
+            }
+        };
+        let rust_file = out_dir.join(format!("{}.rs", model.name));
+        let alone = build_script
+            && std::env::current_exe().is_ok_and(|exe| {
+                std::process::Command::new(exe)
+                    .env(ONE_MODEL, &file)
+                    .env(ONE_OUTPUT, &rust_file)
+                    .stdout(std::process::Stdio::null())
+                    .stderr(std::process::Stdio::null())
+                    .status()
+                    .is_ok_and(|s| s.success())
+            });
+        if !alone {
+            here.push(file);
+            continue;
+        }
+        done.push(Generated {
+            model_file: file,
+            rust_file,
+            type_name: model.type_name(),
+            q: model.coordinates.len(),
+            n: model.velocities.len(),
+        });
+    }
+    for file in here {
         match derive(&file) {
             Ok(d) => {
                 let rust_file = out_dir.join(format!("{}.rs", d.model.name));
@@ -158,6 +218,7 @@ pub fn compile_dir(models_dir: &Path, out_dir: &Path) -> Result<Vec<Generated>, 
     if !errors.is_empty() {
         return Err(errors);
     }
+    done.sort_by(|a, b| a.model_file.cmp(&b.model_file));
     let index = emit::index(&done);
     if let Err(e) = std::fs::write(out_dir.join("models.rs"), index) {
         let mut cx = diag::Collector::new(models_dir, "");
