@@ -6,8 +6,34 @@ use symbolica::evaluate::{Instruction, Slot as ESlot};
 use symbolica::prelude::*;
 
 use super::build::{constant_symbol, own_constants};
+use super::coefficients;
 use crate::ir::Constant;
 use crate::program::{Func, Instr, Program, Slot};
+
+/// Programs for `outputs` (inputs: the `params` parameters first, then
+/// the coordinates and velocities): the evaluator's over the expressions as
+/// they are, then, where they have parameter-only coefficients to name, its
+/// over the expressions with those named ([`coefficients`]), preceded by
+/// the program of the coefficients. The caller keeps the cheaper.
+pub fn programs(outputs: &[Atom], inputs: &[Atom], params: usize) -> Result<Vec<Program>, String> {
+    let plain = program(outputs, inputs)?;
+    let varying: Vec<Symbol> = inputs[params..]
+        .iter()
+        .filter_map(|a| match a.as_view() {
+            AtomView::Var(v) => Some(v.get_symbol()),
+            _ => None,
+        })
+        .collect();
+    let named = coefficients::name(outputs, &varying);
+    if named.symbols.is_empty() {
+        return Ok(vec![plain]);
+    }
+    let first = program(&named.coefficients, &inputs[..params])?;
+    let mut all_inputs = inputs.to_vec();
+    all_inputs.extend(named.symbols.iter().map(|s| Atom::from(*s)));
+    let then = program(&named.outputs, &all_inputs)?.fed_by(&first, inputs.len());
+    Ok(vec![plain, then])
+}
 
 /// An optimised program for `outputs` in terms of `inputs`. π and e enter
 /// as two extra inputs, which become constants of the program with their

@@ -10,13 +10,16 @@
 //! 4. [`walls`]: B, the hypotheses (1.3), P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B (Lemma 1,
 //!    eq. 2.4) and (I − 2P)v (eq. 2.13), exactly;
 //! 5. [`evaluate`]: each emitted function to an optimised straight-line
-//!    program (symbolica's evaluator: common subexpressions, Horner).
+//!    program (symbolica's evaluator: common subexpressions, Horner), also
+//!    with its parameter-only coefficients named first ([`coefficients`]),
+//!    the cheaper of the two kept.
 //!
 //! The result is plain data ([`Derivation`]); [`inspect`] has symbolic
 //! helpers for front ends and tests.
 
 mod build;
 mod checks;
+mod coefficients;
 mod elimination;
 mod evaluate;
 pub mod inspect;
@@ -36,6 +39,7 @@ pub use symbols::sample_configuration;
 
 use crate::diag::{Collector, ErrorKind, ModelErrors, Reported};
 use crate::ir::{Kind, Model};
+use crate::program::Program;
 use crate::quantity::Quantity;
 
 type Rat = RationalPolynomial<IntegerRing, u16>;
@@ -64,6 +68,8 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
     let exact = mechanics::exact(&sym, &low, &raw, cx)?;
     let compile = Compiler {
         inputs: sym.inputs(),
+        params: sym.params.len(),
+        coords: sym.coords.len(),
         kind: model.kind,
     };
     let t_span = &model.kinetic_energy.span;
@@ -144,6 +150,10 @@ fn initial_state(
 /// Turns expressions into the emitted functions of one model.
 pub(crate) struct Compiler {
     inputs: Vec<Atom>,
+    /// How many of the inputs are parameters (they come first), and how
+    /// many coordinates follow them.
+    params: usize,
+    coords: usize,
     kind: Kind,
 }
 
@@ -158,13 +168,39 @@ impl Compiler {
         rows: usize,
         span: &Range<usize>,
     ) -> Result<Function, Reported> {
-        evaluate::program(outputs, &self.inputs)
+        evaluate::programs(outputs, &self.inputs, self.params)
+            .map(|candidates| self.cheapest(quantity, candidates))
             .map(|program| Function {
                 quantity,
                 program,
                 rows,
             })
             .map_err(|e| cx.error(ErrorKind::Symbolic(e), Some(span.clone())))
+    }
+
+    /// The cheapest of programs that compute the same outputs, the first
+    /// on a tie: per call (parameter-only work done once) for every
+    /// function but q̈. Taylor's method spends its time in q̈'s series,
+    /// where a convolution costs a loop over the orders so far and any
+    /// other series operation one step, so for q̈ the fewer convolutions
+    /// decide first, then the per-call cost.
+    fn cheapest(&self, quantity: Quantity, candidates: Vec<Program>) -> Program {
+        let per_call = |p: &Program| p.split(self.params, 0).op_counts(p).0.cost();
+        let key = |p: &Program| match quantity {
+            Quantity::Accelerations => (
+                p.taylor(self.params, self.coords).convolutions(),
+                per_call(p),
+            ),
+            _ => (0, per_call(p)),
+        };
+        let mut best: Option<((usize, usize), Program)> = None;
+        for p in candidates {
+            let k = key(&p);
+            if best.as_ref().is_none_or(|(b, _)| k < *b) {
+                best = Some((k, p));
+            }
+        }
+        best.expect("at least one program").1
     }
 
     /// As [`Compiler::program`], where the model has the quantity (an

@@ -27,12 +27,7 @@ pub(super) fn transforms(d: &Ctx) -> Option<(Transform, Vec<Transform>)> {
 /// Series operations per order, and how many of them are convolutions (a
 /// loop over the coefficients so far): for the header.
 pub(super) fn counts(t: &Transform) -> (usize, usize) {
-    let loops = t
-        .ops
-        .iter()
-        .filter(|op| !matches!(op, Op::Add { .. } | Op::Scale { .. }))
-        .count();
-    (t.ops.len(), loops)
+    (t.ops.len(), t.convolutions())
 }
 
 /// Histories summed side by side in one loop over j: x86-64 has 16

@@ -239,6 +239,31 @@ impl Program {
         (instrs, base)
     }
 
+    /// One program that runs `first` and then this one, whose inputs from
+    /// `base` on are `first`'s outputs in order (`first` reads inputs below
+    /// `base` only): the result has this program's outputs and `base`
+    /// inputs.
+    pub fn fed_by(&self, first: &Program, base: usize) -> Program {
+        debug_assert!(first.inputs <= base && self.inputs == base + first.outputs);
+        let (mut instrs, fed) = first.outputs_as_temps();
+        let temps = fed + first.outputs;
+        let consts = first.consts.len();
+        instrs.extend(self.instrs.iter().map(|ins| {
+            ins.map_slots(|s| match s {
+                Slot::Input(i) if i >= base => Slot::Temp(fed + i - base),
+                Slot::Temp(t) => Slot::Temp(temps + t),
+                Slot::Const(c) => Slot::Const(consts + c),
+                other => other,
+            })
+        }));
+        Program {
+            inputs: base,
+            consts: first.consts.iter().chain(&self.consts).copied().collect(),
+            instrs,
+            outputs: self.outputs,
+        }
+    }
+
     /// Runs the program on `inputs`.
     pub fn eval(&self, inputs: &[f64]) -> Vec<f64> {
         let mut temps: Vec<f64> = Vec::new();
@@ -383,5 +408,33 @@ mod tests {
             p.sincos_pairs(),
             vec![None, None, None, None, Some((0, true)), Some((0, false))]
         );
+    }
+
+    /// A program fed by another computes what the two compute one after
+    /// the other: the second's extra input is the first's output.
+    #[test]
+    fn fed_by_runs_both_in_turn() {
+        // first: k = 2·p (p the only parameter); then: out = k·x + 1.
+        let first = Program {
+            inputs: 1,
+            consts: vec![2.0],
+            instrs: vec![
+                Instr::Mul(Slot::Temp(0), vec![Slot::Const(0), Slot::Input(0)]),
+                Instr::Assign(Slot::Out(0), Slot::Temp(0)),
+            ],
+            outputs: 1,
+        };
+        let then = Program {
+            inputs: 3,
+            consts: vec![1.0],
+            instrs: vec![
+                Instr::Mul(Slot::Temp(0), vec![Slot::Input(2), Slot::Input(1)]),
+                Instr::Add(Slot::Out(0), vec![Slot::Temp(0), Slot::Const(0)]),
+            ],
+            outputs: 1,
+        };
+        let both = then.fed_by(&first, 2);
+        assert_eq!(both.inputs, 2);
+        assert_eq!(both.eval(&[3.0, 5.0]), vec![31.0]);
     }
 }

@@ -20,7 +20,7 @@
 //   all functions                3 add, 21 mul, 2 div, 0 fn (26 in all)
 //
 // Solves, the cheapest form per call (cost: add + mul + 4 div + 20 fn):
-//   floor_collide                M v, M = I - 2P kept with the parameters [linear 13, closed form 20, elimination 23]
+//   floor_collide                M v, M = I - 2P kept with the parameters [linear 13, closed form 15, elimination 23]
 
 /// Parameters of `ball_floor`; `Default` gives the model file's values.
 #[allow(non_snake_case)]

@@ -348,6 +348,15 @@ impl Op {
 }
 
 impl Transform {
+    /// How many of its series operations are convolutions (a loop over the
+    /// coefficients so far, where the others take one step per order).
+    pub fn convolutions(&self) -> usize {
+        self.ops
+            .iter()
+            .filter(|op| !matches!(op, Op::Add { .. } | Op::Scale { .. }))
+            .count()
+    }
+
     /// For each temporary, whether only its current coefficient is ever
     /// read: it is written by a sum, a scaling or a product and read only
     /// by sums, scalings and the outputs, never by a recurrence (which

@@ -16,26 +16,26 @@
 // Operation counts per call (f32):
 //   mass_matrix                  0 add, 1 mul, 0 div, 1 fn (2 in all)
 //   kinetic_energy               5 add, 10 mul, 0 div, 1 fn (16 in all)
-//   potential                    1 add, 2 mul, 0 div, 0 fn (3 in all)
+//   potential                    1 add, 1 mul, 0 div, 0 fn (2 in all)
 //   constraints                  0 add, 5 mul, 0 div, 3 fn (8 in all)
 //   holonomic                    0 add, 0 mul, 0 div, 0 fn (0 in all)
-//   forcing                      17 add, 41 mul, 0 div, 4 fn (62 in all)
-//   constraint_drift             4 add, 15 mul, 0 div, 4 fn (23 in all)
-//   accelerations                9 add, 23 mul, 1 div, 4 fn (37 in all)
+//   forcing                      13 add, 34 mul, 0 div, 4 fn (51 in all)
+//   constraint_drift             4 add, 14 mul, 0 div, 4 fn (22 in all)
+//   accelerations                5 add, 18 mul, 1 div, 4 fn (28 in all)
 //   initial_state                0 add, 1 mul, 0 div, 0 fn (1 in all)
 //   wall_surface                 1 add, 0 mul, 0 div, 0 fn (1 in all)
 //   wall_normal                  0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   wall_normal_velocity         0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   wall_surface_hessian         0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   wall_b_rows                  0 add, 6 mul, 0 div, 4 fn (10 in all)
-//   wall_projector               15 add, 39 mul, 1 div, 4 fn (59 in all)
-//   wall_collide                 29 add, 68 mul, 1 div, 4 fn (102 in all)
+//   wall_projector               10 add, 40 mul, 1 div, 4 fn (55 in all)
+//   wall_collide                 25 add, 55 mul, 1 div, 4 fn (85 in all)
 //
-// Parameter-only work, done once when the parameters are set (23 values kept):
-//   all functions                4 add, 25 mul, 3 div, 0 fn (32 in all)
+// Parameter-only work, done once when the parameters are set (41 values kept):
+//   all functions                6 add, 47 mul, 6 div, 0 fn (59 in all)
 //
 // Solves, the cheapest form per call (cost: add + mul + 4 div + 20 fn):
-//   wall_collide                 the exact closed form [closed form 181, elimination 220]
+//   wall_collide                 the exact closed form [closed form 164, elimination 220]
 
 /// Parameters of `ball_wall_euler`; `Default` gives the model file's values.
 #[allow(non_snake_case)]
@@ -87,7 +87,7 @@ pub struct BallWallEuler {
     /// `set_parameter`, which keep `pre` up to date).
     params: Params,
     /// The parameter-only values the functions read.
-    pre: [f32; 23],
+    pre: [f32; 41],
 }
 impl Default for BallWallEuler {
     /// The model with the model file's parameter values.
@@ -141,19 +141,35 @@ impl BallWallEuler {
     }
     /// The parameter-only values the functions read, from `params`.
     #[allow(unused_variables, unused_mut, clippy::approx_constant)]
-    fn precompute(params: &Params) -> [f32; 23] {
-        let mut pre: [f32; 23] = [0.0; 23];
+    fn precompute(params: &Params) -> [f32; 41] {
+        let mut pre: [f32; 41] = [0.0; 41];
         {
+            let i0: f32 = params.m;
             let i1: f32 = params.r;
             let i3: f32 = params.g;
-            let t0: f32 = i1 * i3;
+            let i4: f32 = params.a;
+            let t0: f32 = i0 * i1 * i3;
             pre[0] = t0;
+            let t1: f32 = i0 * i4;
+            pre[1] = t1;
         }
         {
             let i0: f32 = params.m;
+            let i2: f32 = params.J;
             let i4: f32 = params.a;
-            let o0: f32 = i0 * i4;
-            pre[1] = o0;
+            let t0: f32 = i0 * i4;
+            pre[5] = t0;
+            let t1: f32 = -(i2);
+            pre[2] = t1;
+            let t2: f32 = i2 * -0.5f32;
+            pre[3] = t2;
+            pre[4] = t2 * 2f32;
+            let o0: f32 = t0;
+        }
+        {
+            let i1: f32 = params.r;
+            let t0: f32 = -(i1);
+            pre[6] = t0;
         }
         {
             let i0: f32 = params.m;
@@ -162,67 +178,101 @@ impl BallWallEuler {
             let i4: f32 = params.a;
             let t0: f32 = i1 * i1;
             let t0: f32 = i0 * t0;
-            pre[2] = t0;
             let t1: f32 = i2 + t0;
-            let t1: f32 = 1.0 / (t1);
-            let t1: f32 = -(t1);
-            pre[3] = t1;
-            let o0: f32 = i4 * t0 * t1;
-            pre[4] = o0;
-            let o2: f32 = i0 * i4;
-            pre[5] = o2;
-            pre[6] = i0 * i1;
+            pre[7] = t1;
+            let t3: f32 = 1.0 / (t1);
+            pre[8] = t3;
+            let t2: f32 = -(i4);
+            let t0: f32 = t0 * t3 * t2;
+            pre[11] = t0;
+            let t2: f32 = i0 * i1 * t2;
+            pre[9] = t2;
+            let t4: f32 = 1.0 / (t1);
+            pre[10] = t4;
+            let o0: f32 = t0;
         }
         {
             let i1: f32 = params.r;
             let o0: f32 = -(i1);
-            pre[7] = o0;
+            pre[12] = o0;
         }
         {
             let i1: f32 = params.r;
             let o17: f32 = -(i1);
-            pre[8] = o17;
+            pre[13] = o17;
         }
         {
             let i0: f32 = params.m;
             let i1: f32 = params.r;
             let i2: f32 = params.J;
-            let o21: f32 = i1 * i1;
-            let o21: f32 = i0 * o21;
-            pre[9] = o21;
-            let t1: f32 = i2 * 2f32;
-            pre[10] = t1;
-            let o22: f32 = o21 + t1;
-            let o22: f32 = 1.0 / (o22);
-            pre[11] = o22;
-            let o23: f32 = i2 * o22;
-            pre[12] = o23;
-            let o6: f32 = 2f32 * o23;
-            pre[13] = o6;
-            let o9: f32 = i1 * o23;
-            pre[14] = o9;
-            let o7: f32 = -(o9);
-            pre[15] = o7;
-            let o18: f32 = i0 * i1;
-            pre[16] = o18;
+            let t6: f32 = i1 * i1;
+            let t6: f32 = i0 * t6;
+            let t8: f32 = i2 * 2f32;
+            pre[14] = t8;
+            let t4: f32 = t6 + t8;
+            pre[15] = t4;
+            let t3: f32 = 1.0 / (t4);
+            pre[16] = t3;
+            let t10: f32 = i2 * t3;
+            pre[17] = t10;
+            let t0: f32 = 2f32 * t10;
+            pre[26] = t0;
+            let t5: f32 = -(i1);
+            let t1: f32 = t10 * t5;
+            pre[27] = t1;
+            let t2: f32 = i1 * i2;
+            let t5: f32 = i0 * t5;
+            pre[18] = t5;
+            let t6: f32 = i2 + t6;
+            pre[19] = t6;
+            let t7: f32 = -(i2);
+            pre[20] = t7;
+            let t9: f32 = i0 * i1 * t3;
+            pre[21] = t9;
+            pre[22] = -(t1);
+            pre[23] = t2 * t3;
+            let t15: f32 = 1.0 / (t4);
+            pre[24] = t15;
+            pre[25] = -(t5);
+            let o6: f32 = t0;
+            let o7: f32 = t1;
         }
         {
             let i0: f32 = params.m;
             let i1: f32 = params.r;
             let i2: f32 = params.J;
-            let t1: f32 = i1 * i1;
-            let t1: f32 = i0 * t1;
-            pre[17] = t1;
-            let t2: f32 = i2 * 2f32;
-            let t2: f32 = t1 + t2;
-            let t2: f32 = 1.0 / (t2);
-            pre[18] = t2;
-            pre[19] = -(i1);
-            let t13: f32 = -2f32 * t2;
-            pre[20] = t13;
-            let t16: f32 = i0 * i1;
-            pre[21] = t16;
-            pre[22] = i2 + t1;
+            let t0: f32 = i1 * i2;
+            pre[28] = t0;
+            let t6: f32 = i1 * i1;
+            let t6: f32 = i0 * t6;
+            let t8: f32 = i2 * 2f32;
+            pre[29] = t8;
+            let t4: f32 = t6 + t8;
+            pre[30] = t4;
+            let t3: f32 = 1.0 / (t4);
+            let t2: f32 = i2 * t3;
+            let t1: f32 = i1 * 2f32 * t2;
+            pre[31] = t1;
+            let t2: f32 = -4f32 * t2;
+            let t2: f32 = 1f32 + t2;
+            pre[32] = t2;
+            let t3: f32 = -2f32 * t3;
+            pre[33] = t3;
+            let t11: f32 = i0 * i1;
+            let t5: f32 = -(t11);
+            pre[34] = t5;
+            let t6: f32 = i2 + t6;
+            pre[35] = t6;
+            let t7: f32 = -(i2);
+            pre[36] = t7;
+            let t9: f32 = t3 * t11;
+            pre[37] = t9;
+            let t10: f32 = i2 * t3;
+            pre[38] = t10;
+            let t11: f32 = -2f32 * t11;
+            pre[39] = t11;
+            let t18: f32 = 1.0 / (t4);
+            pre[40] = t18;
         }
         pre
     }
@@ -299,13 +349,11 @@ impl BallWallEuler {
     #[inline]
     #[allow(unused_variables, clippy::approx_constant)]
     pub fn potential(&self, q: &[f32; 5]) -> f32 {
-        let i0: f32 = self.params.m;
-        let i4: f32 = self.params.a;
         let i5: f32 = q[0];
         let t0: f32 = self.pre[0];
-        let o0: f32 = i4 * i5;
-        let t0: f32 = t0 + o0;
-        let o0: f32 = i0 * t0;
+        let t1: f32 = self.pre[1];
+        let o0: f32 = i5 * t1;
+        let o0: f32 = t0 + o0;
         o0
     }
     /// Rows of A(q).
@@ -351,72 +399,62 @@ impl BallWallEuler {
     #[inline]
     #[allow(unused_variables, clippy::approx_constant)]
     pub fn forcing(&self, q: &[f32; 5], v: &[f32; 5]) -> [f32; 5] {
-        let i2: f32 = self.params.J;
         let i7: f32 = q[2];
         let i8: f32 = q[3];
         let i12: f32 = v[2];
         let i13: f32 = v[3];
         let i14: f32 = v[4];
-        let o0: f32 = self.pre[1];
+        let t1: f32 = self.pre[2];
+        let t2: f32 = self.pre[3];
         let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
-        let o4: f32 = sc0_sin;
-        let t2: f32 = i14 * o4;
-        let t3: f32 = i2 * i13;
-        let o2: f32 = t2 * t3;
+        let t3: f32 = sc0_sin;
+        let t4: f32 = i14 * t3;
+        let t5: f32 = i13 * t1 * t4;
         let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
-        let t5: f32 = sc1_cos;
-        let t6: f32 = i13 * t5;
-        let t7: f32 = sc1_sin;
-        let t8: f32 = t2 * t7;
-        let t6: f32 = t6 + t8;
-        let t8: f32 = i13 * t7;
-        let t9: f32 = -(t8);
-        let t10: f32 = t2 * t5;
-        let t9: f32 = t9 + t10;
-        let t11: f32 = t6 * t9;
-        let t10: f32 = -(t10);
-        let t8: f32 = t8 + t10;
-        let t10: f32 = t6 * t8;
-        let t10: f32 = t11 + t10;
-        let t11: f32 = i2 * t10;
-        let t10: f32 = o2 + t11;
-        let o2: f32 = -(t10);
-        let t11: f32 = t5 * t8;
-        let t10: f32 = t5 * t9;
-        let t10: f32 = t11 + t10;
-        let t10: f32 = i12 * t10;
-        let t12: f32 = sc0_cos;
-        let o3: f32 = i14 * t12;
-        let t6: f32 = t7 * t6;
-        let t14: f32 = 2f32 * o3 * t6;
-        let t15: f32 = i12 + o3;
-        let t16: f32 = t2 * t15;
-        let o3: f32 = t11 * o3;
-        let o3: f32 = t16 + o3;
-        let t16: f32 = -2f32 * o3;
-        let o3: f32 = t14 + t16;
-        let t14: f32 = -0.5f32 * o3;
-        let t16: f32 = t10 + t14;
-        let o3: f32 = i2 * t16;
-        let t10: f32 = o4 * t7;
-        let t14: f32 = t8 * t10;
-        let t16: f32 = t9 * t10;
-        let t8: f32 = t14 + t16;
-        let t9: f32 = i2 * i12 * t8;
-        let t10: f32 = -2f32 * o4 * t15;
-        let t14: f32 = t2 + t11;
-        let t16: f32 = -2f32 * t14;
-        let t8: f32 = t5 * t5;
-        let o4: f32 = t2 * t8;
-        let t15: f32 = t7 * t7;
-        let t11: f32 = t2 * t15;
-        let t14: f32 = t6 + o4 + t11;
-        let t5: f32 = 2f32 * t14;
-        let t8: f32 = t16 + t5;
-        let t7: f32 = t12 * t8;
-        let t2: f32 = t10 + t7;
-        let t15: f32 = 0.5f32 * t3 * t2;
-        let o4: f32 = t9 + t15;
+        let t6: f32 = sc1_cos;
+        let t7: f32 = i13 * t6;
+        let t8: f32 = sc1_sin;
+        let t9: f32 = t4 * t8;
+        let t7: f32 = t7 + t9;
+        let t9: f32 = i13 * t8;
+        let o2: f32 = -(t9);
+        let t11: f32 = t4 * t6;
+        let o2: f32 = o2 + t11;
+        let o2: f32 = t7 * o2;
+        let o4: f32 = -(t11);
+        let t9: f32 = t9 + o4;
+        let o4: f32 = t7 * t9;
+        let o2: f32 = o2 + o4;
+        let o4: f32 = self.pre[4] * o2;
+        let o2: f32 = t5 + o4;
+        let t5: f32 = sc0_cos;
+        let o4: f32 = t8 * t7;
+        let t7: f32 = 2f32 * t5;
+        let o3: f32 = o4 * t7;
+        let t14: f32 = i14 * t5;
+        let t14: f32 = i12 + t14;
+        let t3: f32 = t3 * t14;
+        let t14: f32 = t9 * t5;
+        let t9: f32 = t6 * t14;
+        let t9: f32 = t3 + t9;
+        let t9: f32 = -2f32 * t9;
+        let t9: f32 = o3 + t9;
+        let o3: f32 = i14 * t2 * t9;
+        let t9: f32 = -2f32 * t3;
+        let t3: f32 = t11 * t7;
+        let t7: f32 = -2f32 * t14;
+        let t11: f32 = t3 + t7;
+        let t14: f32 = t6 * t11;
+        let t3: f32 = -2f32 * t4;
+        let t7: f32 = t8 * t8;
+        let t6: f32 = t4 * t7;
+        let t11: f32 = o4 + t6;
+        let t8: f32 = 2f32 * t11;
+        let t4: f32 = t3 + t8;
+        let t7: f32 = t5 * t4;
+        let t6: f32 = t9 + t14 + t7;
+        let o4: f32 = -(i13 * t2 * t6);
+        let o0: f32 = self.pre[5];
         let o1: f32 = 0f32;
         [o0, o1, o2, o3, o4]
     }
@@ -430,86 +468,71 @@ impl BallWallEuler {
         let i12: f32 = v[2];
         let i13: f32 = v[3];
         let i14: f32 = v[4];
+        let t0: f32 = self.pre[6];
         let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
-        let o1: f32 = sc0_cos;
+        let t1: f32 = sc0_cos;
         let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
-        let t1: f32 = sc1_cos;
-        let t2: f32 = i1 * i14;
-        let t1: f32 = i13 * t1;
-        let t1: f32 = t2 * t1;
-        let t3: f32 = o1 * t1;
-        let t4: f32 = i1 * i13;
-        let o0: f32 = o1 * t4;
+        let t2: f32 = sc1_cos;
+        let t3: f32 = i1 * i14;
+        let o0: f32 = i13 * t1;
+        let t2: f32 = t2 * t3;
+        let t5: f32 = o0 * t2;
         let t6: f32 = sc0_sin;
-        let t7: f32 = sc1_sin;
-        let t2: f32 = t2 * t7;
-        let t7: f32 = t6 * t2;
-        let o0: f32 = o0 + t7;
-        let t7: f32 = -(i12 * o0);
-        let o0: f32 = t3 + t7;
-        let t3: f32 = t1 * t6;
-        let t7: f32 = -(t4 * t6);
-        let t1: f32 = o1 * t2;
-        let t4: f32 = t7 + t1;
-        let t6: f32 = i12 * t4;
-        let o1: f32 = t3 + t6;
+        let o1: f32 = sc1_sin;
+        let t8: f32 = i14 * t6 * o1;
+        let o0: f32 = o0 + t8;
+        let t8: f32 = i12 * t0 * o0;
+        let o0: f32 = t5 + t8;
+        let t5: f32 = i13 * t6;
+        let t8: f32 = t2 * t5;
+        let t6: f32 = t1 * t3 * o1;
+        let t2: f32 = t0 * t5;
+        let t1: f32 = t6 + t2;
+        let t3: f32 = i12 * t1;
+        let o1: f32 = t8 + t3;
         [o0, o1, 0.0, 0.0, 0.0]
     }
     /// q̈ of the equations of motion G(q) q̈ + h(q, q̇) = A(q)ᵀλ, A(q) q̈ + Ȧq̇ = 0, written out: in exact closed form where G⁻¹ is exact, else as the solve by elimination (G = LDLᵀ, then the constraints' Schur complement; q̇ should satisfy A(q) q̇ = 0). Non-finite where G is singular.
     #[inline]
     #[allow(unused_variables, clippy::approx_constant)]
     pub fn accelerations(&self, q: &[f32; 5], v: &[f32; 5]) -> [f32; 5] {
-        let i1: f32 = self.params.r;
-        let i2: f32 = self.params.J;
-        let i4: f32 = self.params.a;
         let i7: f32 = q[2];
         let i8: f32 = q[3];
         let i12: f32 = v[2];
         let i13: f32 = v[3];
         let i14: f32 = v[4];
-        let t0: f32 = self.pre[2];
-        let t1: f32 = self.pre[3];
-        let o0: f32 = self.pre[4];
+        let t1: f32 = self.pre[7];
+        let t3: f32 = self.pre[8];
+        let t2: f32 = self.pre[9];
+        let t4: f32 = self.pre[10];
         let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
-        let o3: f32 = sc0_sin;
-        let t4: f32 = t0 * o3;
-        let t5: f32 = i2 * o3;
-        let t4: f32 = t4 + t5;
-        let t5: f32 = 1.0 / (t4);
+        let t5: f32 = sc0_cos;
+        let t6: f32 = -(t5);
+        let o3: f32 = i12 * t6;
+        let o3: f32 = i14 + o3;
+        let t8: f32 = i13 * t1;
+        let o3: f32 = o3 * t8;
         let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
-        let t4: f32 = sc1_cos;
-        let o4: f32 = sc0_cos;
-        let o4: f32 = -(o4);
-        let o2: f32 = self.pre[5];
-        let t4: f32 = i1 * t4;
-        let t4: f32 = o2 * t4;
-        let o2: f32 = o4 * t4;
-        let t8: f32 = i12 * o4;
-        let t8: f32 = i14 + t8;
-        let t9: f32 = t0 * t8;
-        let t8: f32 = i2 * t8;
-        let t8: f32 = t9 + t8;
-        let t9: f32 = i13 * t8;
-        let t8: f32 = o2 + t9;
-        let o2: f32 = t5 * t8;
-        let t9: f32 = i14 * o3;
-        let t8: f32 = i12 * t9;
-        let o3: f32 = i1 * t8;
-        let t9: f32 = sc1_sin;
-        let t9: f32 = i4 * t9;
-        let o3: f32 = o3 + t9;
-        let t9: f32 = self.pre[6] * o3;
-        let o3: f32 = i2 * t8;
-        let t8: f32 = t9 + o3;
-        let o3: f32 = t1 * t8;
-        let t9: f32 = i14 * o4;
-        let t1: f32 = i12 + t9;
-        let t8: f32 = t0 * t1;
-        let o4: f32 = i2 * t1;
-        let t9: f32 = t8 + o4;
-        let t0: f32 = i13 * t9;
-        let t1: f32 = t4 + t0;
-        let o4: f32 = t5 * t1;
+        let o4: f32 = sc1_cos;
+        let o4: f32 = t2 * o4;
+        let t5: f32 = t5 * o4;
+        let t5: f32 = o3 + t5;
+        let o3: f32 = sc0_sin;
+        let o2: f32 = 1.0 / (o3);
+        let t4: f32 = t4 * o2;
+        let o2: f32 = t5 * t4;
+        let t5: f32 = -(i12 * i14 * t1 * o3);
+        let o3: f32 = sc1_sin;
+        let o3: f32 = t2 * o3;
+        let t5: f32 = t5 + o3;
+        let o3: f32 = t3 * t5;
+        let t5: f32 = i14 * t6;
+        let t6: f32 = i12 + t5;
+        let t5: f32 = t8 * t6;
+        let t6: f32 = -(o4);
+        let t8: f32 = t5 + t6;
+        let o4: f32 = t4 * t8;
+        let o0: f32 = self.pre[11];
         let o1: f32 = 0f32;
         [o0, o1, o2, o3, o4]
     }
@@ -534,7 +557,7 @@ impl BallWallEuler {
     #[allow(unused_variables, clippy::approx_constant)]
     pub fn wall_surface(&self, q: &[f32; 5]) -> f32 {
         let i5: f32 = q[0];
-        let o0: f32 = self.pre[7];
+        let o0: f32 = self.pre[12];
         let o0: f32 = i5 + o0;
         o0
     }
@@ -573,7 +596,7 @@ impl BallWallEuler {
         let i8: f32 = q[3];
         let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
         let o14: f32 = sc0_sin;
-        let o17: f32 = self.pre[8];
+        let o17: f32 = self.pre[13];
         let o8: f32 = o14 * o17;
         let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
         let o19: f32 = sc1_sin;
@@ -615,77 +638,74 @@ impl BallWallEuler {
         let i2: f32 = self.params.J;
         let i7: f32 = q[2];
         let i8: f32 = q[3];
-        let o21: f32 = self.pre[9];
-        let t1: f32 = self.pre[10];
-        let o22: f32 = self.pre[11];
-        let o23: f32 = self.pre[12];
-        let o6: f32 = self.pre[13];
-        let o9: f32 = self.pre[14];
-        let o7: f32 = self.pre[15];
+        let t8: f32 = self.pre[14];
+        let t4: f32 = self.pre[15];
+        let t3: f32 = self.pre[16];
+        let t10: f32 = self.pre[17];
+        let t5: f32 = self.pre[18];
+        let t6: f32 = self.pre[19];
+        let t7: f32 = self.pre[20];
+        let t9: f32 = self.pre[21];
         let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
-        let t7: f32 = sc0_cos;
-        let o8: f32 = o9 * t7;
-        let t9: f32 = sc0_sin;
+        let o23: f32 = sc0_cos;
+        let o8: f32 = self.pre[22] * o23;
+        let o21: f32 = sc0_sin;
         let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
-        let t10: f32 = sc1_sin;
-        let o14: f32 = t9 * t10;
-        let o19: f32 = sc1_cos;
-        let o16: f32 = -(o19);
-        let t14: f32 = o14 + o16;
-        let o9: f32 = o9 * t14;
-        let t14: f32 = t9 * o19;
-        let o11: f32 = t10 + t14;
-        let t16: f32 = o21 * t10;
-        let t1: f32 = t1 * t10;
-        let t1: f32 = t16 + t1;
-        let t1: f32 = 1.0 / (t1);
-        let o18: f32 = self.pre[16];
-        let t18: f32 = t1 * o18;
-        let o11: f32 = -(o11 * t18);
-        let t19: f32 = -(t9);
-        let o12: f32 = o19 * t19;
-        let o12: f32 = t10 + o12;
-        let o12: f32 = i2 * o12;
-        let o12: f32 = t16 + o12;
-        let o12: f32 = t1 * o12;
-        let o13: f32 = t7 * t14;
-        let t22: f32 = t7 * t10;
-        let o13: f32 = o13 + t22;
-        let t23: f32 = i2 * t1;
-        let o13: f32 = o13 * t23;
-        let o14: f32 = 2f32 * o14;
-        let o24: f32 = t9 * t9;
-        let o17: f32 = o19 * o24;
-        let o14: f32 = o16 + o14 + o17;
-        let o16: f32 = t10 * o14;
-        let o17: f32 = t19 + o16;
-        let o14: f32 = t23 * o17;
-        let o16: f32 = o22 * t7 * o18;
-        let o17: f32 = o23 * t7;
-        let o18: f32 = 1f32 + o24;
+        let o24: f32 = sc1_sin;
+        let t15: f32 = o21 * o24;
+        let o17: f32 = sc1_cos;
+        let o9: f32 = -(o17);
+        let t15: f32 = t15 + o9;
+        let o9: f32 = self.pre[23] * t15;
+        let t15: f32 = self.pre[24];
+        let t18: f32 = o21 * o17;
+        let o11: f32 = o24 + t18;
+        let o18: f32 = 1.0 / (o24);
+        let t15: f32 = t15 * o18;
+        let o18: f32 = o11 * t15;
+        let o11: f32 = t5 * o18;
+        let o13: f32 = t6 * o24;
+        let o12: f32 = t7 * t18;
+        let o13: f32 = o13 + o12;
+        let o12: f32 = t15 * o13;
+        let o13: f32 = i2 * o23 * o18;
+        let o18: f32 = o21 * o21;
+        let o22: f32 = i2 * o17;
+        let t24: f32 = o24 * o18;
+        let o14: f32 = o22 * t24;
+        let o17: f32 = o24 * o17;
+        let o17: f32 = o21 + o17;
+        let o17: f32 = t7 * o17;
+        let o16: f32 = o24 * o24;
+        let o16: f32 = t8 * o21 * o16;
+        let o17: f32 = o14 + o17 + o16;
+        let o14: f32 = t15 * o17;
+        let o16: f32 = t9 * o23;
+        let o17: f32 = t10 * o23;
         let o18: f32 = i2 * o18;
-        let o21: f32 = o21 + o18;
-        let o18: f32 = o22 * o21;
-        let o21: f32 = t19 * t22;
-        let o22: f32 = t7 * o19;
-        let t22: f32 = o21 + o22;
-        let o19: f32 = o23 * t22;
-        let o21: f32 = t9 * t18;
-        let o22: f32 = t9 * t23;
-        let o23: f32 = t7 * t19 * t23;
-        let t22: f32 = -(o24);
-        let t18: f32 = 2f32 + t22;
-        let t9: f32 = t10 * t18;
-        let t7: f32 = t14 + t9;
-        let t19: f32 = i2 * t7;
-        let t23: f32 = t16 + t19;
-        let o24: f32 = t1 * t23;
+        let o18: f32 = t6 + o18;
+        let o18: f32 = t3 * o18;
+        let t27: f32 = t7 * o21;
+        let o19: f32 = o24 * t27;
+        let o22: f32 = o22 + o19;
+        let o19: f32 = t3 * o23 * o22;
+        let o22: f32 = o21 * t15;
+        let o21: f32 = self.pre[25] * o22;
+        let o22: f32 = i2 * o22;
+        let o23: f32 = o23 * t15 * t27;
+        let t27: f32 = i2 * t18;
+        let t18: f32 = t4 * o24;
+        let o24: f32 = t7 * t24;
+        let t24: f32 = t27 + t18 + o24;
+        let o24: f32 = t15 * t24;
         let o0: f32 = 1f32;
         let o1: f32 = 0f32;
         let o2: f32 = 0f32;
         let o3: f32 = 0f32;
         let o4: f32 = 0f32;
         let o5: f32 = 0f32;
+        let o6: f32 = self.pre[26];
+        let o7: f32 = self.pre[27];
         let o10: f32 = 0f32;
         let o15: f32 = 0f32;
         let o20: f32 = 0f32;
@@ -701,7 +721,6 @@ impl BallWallEuler {
     #[inline]
     #[allow(unused_variables, clippy::approx_constant)]
     pub fn wall_collide(&self, q: &[f32; 5], v: &[f32; 5]) -> [f32; 5] {
-        let i1: f32 = self.params.r;
         let i2: f32 = self.params.J;
         let i7: f32 = q[2];
         let i8: f32 = q[3];
@@ -710,93 +729,92 @@ impl BallWallEuler {
         let i12: f32 = v[2];
         let i13: f32 = v[3];
         let i14: f32 = v[4];
+        let t0: f32 = self.pre[28];
+        let t8: f32 = self.pre[29];
+        let t4: f32 = self.pre[30];
+        let t1: f32 = self.pre[31];
+        let t2: f32 = self.pre[32];
+        let t3: f32 = self.pre[33];
+        let t5: f32 = self.pre[34];
+        let t6: f32 = self.pre[35];
+        let t7: f32 = self.pre[36];
+        let t9: f32 = self.pre[37];
+        let t10: f32 = self.pre[38];
+        let t11: f32 = self.pre[39];
         let o0: f32 = -(i10);
-        let t1: f32 = self.pre[17];
-        let t2: f32 = self.pre[18];
-        let t3: f32 = i12 * 2f32 * t2;
+        let o1: f32 = i11 * t2;
         let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
-        let t4: f32 = sc0_cos;
-        let t5: f32 = t2 * t4;
-        let o1: f32 = i13 * -2f32 * t5;
-        let t3: f32 = t3 + o1;
-        let o1: f32 = i1 * t3;
-        let t3: f32 = i11 * -4f32 * t2;
-        let t3: f32 = o1 + t3;
-        let o1: f32 = i2 * t3;
-        let t3: f32 = sc0_sin;
+        let t14: f32 = sc0_sin;
         let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
-        let t7: f32 = sc1_sin;
-        let o3: f32 = i2 * t7;
-        let t9: f32 = t3 * o3;
-        let t10: f32 = i1 * t9;
-        let o2: f32 = sc1_cos;
-        let t12: f32 = i2 * o2;
-        let t13: f32 = self.pre[19] * t12;
-        let t10: f32 = t10 + t13;
-        let t13: f32 = self.pre[20];
-        let t10: f32 = i14 * t10 * t13;
-        let o1: f32 = i11 + o1 + t10;
-        let t10: f32 = t1 * t7;
-        let t14: f32 = 2f32 * o3;
-        let t14: f32 = t10 + t14;
-        let t15: f32 = 1.0 / (t14);
-        let t16: f32 = self.pre[21];
-        let t17: f32 = t3 * t16;
-        let t18: f32 = o2 * t17;
-        let t19: f32 = t7 * t16;
-        let t18: f32 = t18 + t19;
-        let t19: f32 = 2f32 * t15;
-        let t18: f32 = i11 * t18 * t19;
-        let t20: f32 = i2 * t3;
-        let t21: f32 = o2 * t20;
-        let t22: f32 = -(t21);
-        let t10: f32 = o3 + t10 + t22;
-        let t22: f32 = -2f32 * t15;
-        let t10: f32 = t10 * t22;
-        let t10: f32 = 1f32 + t10;
-        let t10: f32 = i12 * t10;
-        let t23: f32 = t4 * t21;
-        let t24: f32 = t4 * o3;
-        let t23: f32 = t23 + t24;
-        let t24: f32 = i13 * t15 * t23;
-        let t23: f32 = t7 * t7;
-        let t7: f32 = 2f32 * t20 * t23;
-        let t23: f32 = t3 * t3;
-        let t3: f32 = o3 * t23;
-        let o4: f32 = o2 * t3;
-        let o3: f32 = o3 * o2;
-        let o2: f32 = t20 + o3;
-        let o3: f32 = -(o2);
-        let o2: f32 = t7 + o4 + o3;
-        let t7: f32 = i14 * t15 * o2;
-        let o3: f32 = t24 + t7;
-        let o4: f32 = -2f32 * o3;
-        let o2: f32 = t18 + t10 + o4;
-        let t15: f32 = i2 * t23;
-        let t7: f32 = self.pre[22] + t15;
-        let t24: f32 = t13 * t7;
-        let o3: f32 = 1f32 + t24;
-        let t10: f32 = i13 * o3;
-        let t18: f32 = i11 * t5 * t16;
-        let o4: f32 = i2 * i12 * t5;
-        let t23: f32 = -(t4 * t9);
-        let t1: f32 = t4 * t12;
-        let t15: f32 = t23 + t1;
-        let t7: f32 = i14 * t2 * t15;
-        let t13: f32 = t18 + o4 + t7;
-        let t24: f32 = -2f32 * t13;
-        let o3: f32 = t10 + t24;
-        let t16: f32 = i11 * t17 * t22;
-        let t5: f32 = i12 * t22;
-        let t9: f32 = i13 * t4 * t19;
-        let t12: f32 = t5 + t9;
-        let t1: f32 = t20 * t12;
-        let t23: f32 = -(t3);
-        let t2: f32 = t14 + t21 + t23;
-        let t15: f32 = t22 * t2;
-        let t7: f32 = 1f32 + t15;
-        let t18: f32 = i14 * t7;
-        let o4: f32 = t16 + t1 + t18;
+        let t15: f32 = sc1_sin;
+        let t16: f32 = t14 * t15;
+        let t17: f32 = sc1_cos;
+        let t18: f32 = -(t17);
+        let t18: f32 = t16 + t18;
+        let t18: f32 = i14 * t0 * t3 * t18;
+        let t19: f32 = sc0_cos;
+        let t20: f32 = i13 * t19;
+        let t21: f32 = -(t20);
+        let t21: f32 = i12 + t21;
+        let t21: f32 = t1 * t21;
+        let o1: f32 = o1 + t18 + t21;
+        let t18: f32 = self.pre[40];
+        let t21: f32 = t6 * t15;
+        let t22: f32 = t14 * t17;
+        let t23: f32 = t7 * t22;
+        let t21: f32 = t21 + t23;
+        let t23: f32 = 1.0 / (t15);
+        let t18: f32 = t18 * t23;
+        let t23: f32 = -2f32 * t18;
+        let t21: f32 = t21 * t23;
+        let t21: f32 = 1f32 + t21;
+        let t21: f32 = i12 * t21;
+        let o2: f32 = t15 + t22;
+        let o2: f32 = t18 * o2;
+        let o4: f32 = i2 * t20 * o2;
+        let o2: f32 = i11 * t5 * o2;
+        let t26: f32 = t15 * t17;
+        let t26: f32 = t14 + t26;
+        let t26: f32 = t7 * t26;
+        let t27: f32 = t14 * t14;
+        let t17: f32 = i2 * t17;
+        let t28: f32 = t27 * t17;
+        let o3: f32 = t8 * t16;
+        let t28: f32 = t28 + o3;
+        let o3: f32 = t15 * t28;
+        let t28: f32 = t26 + o3;
+        let t26: f32 = i14 * t18 * t28;
+        let o3: f32 = o4 + o2 + t26;
+        let t28: f32 = -2f32 * o3;
+        let o2: f32 = t21 + t28;
+        let o4: f32 = i2 * t27;
+        let t26: f32 = t6 + o4;
+        let o3: f32 = i13 * t26;
+        let t21: f32 = t19 * t17;
+        let t28: f32 = t7 * t16 * t19;
+        let o4: f32 = t21 + t28;
+        let t26: f32 = i14 * o4;
+        let t17: f32 = o3 + t26;
+        let t16: f32 = t3 * t17;
+        let t21: f32 = i11 * t9;
+        let t28: f32 = i12 * t10;
+        let o4: f32 = t21 + t28;
+        let t26: f32 = t19 * o4;
+        let o3: f32 = i13 + t16 + t26;
+        let t17: f32 = t14 * t18;
+        let t21: f32 = i11 * t11 * t17;
+        let t28: f32 = i2 * t22;
+        let t19: f32 = t4 * t15;
+        let o4: f32 = t7 * t15 * t27;
+        let t16: f32 = t28 + t19 + o4;
+        let t26: f32 = t23 * t16;
+        let t14: f32 = 1f32 + t26;
+        let t18: f32 = i14 * t14;
+        let t22: f32 = -(i12 * t17);
+        let t15: f32 = t20 * t17;
+        let t27: f32 = t22 + t15;
+        let t19: f32 = t8 * t27;
+        let o4: f32 = t21 + t18 + t19;
         [o0, o1, o2, o3, o4]
     }
 }
