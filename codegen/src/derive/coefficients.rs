@@ -6,16 +6,16 @@
 //! of its Horner scheme, and the per-call code multiplies masses and lengths
 //! term by term. Here every sum is regrouped by the part of each term that
 //! depends on the coordinates or velocities, and the parameter-only factor
-//! of each group (`l1*l2*(m2 + m3)`) becomes one new symbol: the same
-//! entry reads `k0*sin(q1)*sin(q2) + k0*cos(q1)*cos(q2)`, which the
-//! evaluator factors to `k0*(…)`. The named coefficients are a program of
-//! their own over the parameters (done once per parameter set, see
-//! [`crate::program::Split`]), which the per-call program reads as inputs.
-//!
-//! Equal coefficients, or opposite ones, share one symbol, and terms whose
-//! coefficient is one symbol share it as a factor: `k0*(sin(q1)*sin(q2) +
-//! cos(q1)*cos(q2))`, three multiplications and an addition per call where
-//! the expanded entry took eleven and three.
+//! of each group (`l1*l2*(m2 + m3)`) becomes one new symbol. Equal
+//! coefficients, or opposite ones, share one symbol, and terms whose
+//! coefficient is one symbol share it as a factor (the evaluator does not
+//! always find that factor itself): the same entry reads
+//! `k0*(sin(q1)*sin(q2) + cos(q1)*cos(q2))`, three multiplications and an
+//! addition per call. chain_8's G took 173 multiplications and 85 additions
+//! per call expanded, and takes 84 and 28 so. The named coefficients are a
+//! program of their own over the parameters (done once per parameter set,
+//! see [`crate::program::Split`]), which the per-call program reads as
+//! inputs.
 
 use symbolica::prelude::*;
 
