@@ -3,16 +3,11 @@
 //! emitted code shows up here for review. Uses the symbolic engine: run one
 //! test at a time (`RUST_TEST_THREADS=1`).
 
-use std::path::Path;
+mod common;
 
 #[test]
 fn generated_files_match_their_snapshots() {
-    let mut files: Vec<_> = std::fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("models"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    files.sort();
+    let files = common::model_files();
     assert!(!files.is_empty());
     for file in files {
         let name = format!("generated_{}", file.file_stem().unwrap().to_string_lossy());

@@ -7,6 +7,8 @@
 use std::path::Path;
 use std::process::Command;
 
+mod common;
+
 const CHILD: &str = "DALEMBERT_REPRODUCIBLE_CHILD";
 
 /// A model that makes chain_3's names in another order (q3 before q1, the
@@ -57,12 +59,8 @@ fn generate_in_child() {
     std::fs::write(out, code).unwrap();
 }
 
-fn generated(prelude: bool, tag: &str) -> String {
-    generated_model(None, prelude, tag)
-}
-
 /// What a child process generates for `model` (chain_3 by default).
-fn generated_model(model: Option<&Path>, prelude: bool, tag: &str) -> String {
+fn generated(model: Option<&Path>, prelude: bool, tag: &str) -> String {
     let out = std::env::temp_dir().join(format!(
         "dalembert-reproducible-{}-{tag}.rs",
         std::process::id()
@@ -89,8 +87,8 @@ fn generated_code_does_not_depend_on_earlier_derivations() {
     if std::env::var(CHILD).is_ok() {
         return;
     }
-    let alone = generated(false, "alone");
-    let after = generated(true, "after");
+    let alone = generated(None, false, "alone");
+    let after = generated(None, true, "after");
     assert!(alone.contains("pub fn floor_collide"));
     assert!(
         alone == after,
@@ -108,20 +106,14 @@ fn build_script_output_matches_each_model_generated_alone() {
     if std::env::var(CHILD).is_ok() {
         return;
     }
-    let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
-    let mut files: Vec<_> = std::fs::read_dir(&models)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    files.sort();
+    let files = common::model_files();
     assert!(files.len() > 10, "the built-in models are missing");
     let mut differ = Vec::new();
     for file in &files {
         let name = file.file_stem().unwrap().to_string_lossy().into_owned();
         let built = std::fs::read_to_string(Path::new(env!("OUT_DIR")).join(format!("{name}.rs")))
             .unwrap_or_else(|e| panic!("{name}: the build script's file: {e}"));
-        if generated_model(Some(file), false, &name) != built {
+        if generated(Some(file), false, &name) != built {
             differ.push(name);
         }
     }

@@ -171,46 +171,40 @@ pub fn compile_dir(models_dir: &Path, out_dir: &Path) -> Result<Vec<Generated>, 
                 continue;
             }
         };
-        let rust_file = out_dir.join(format!("{}.rs", model.name));
+        let generated = Generated {
+            rust_file: out_dir.join(format!("{}.rs", model.name)),
+            model_file: file,
+            type_name: model.type_name(),
+            q: model.coordinates.len(),
+            n: model.velocities.len(),
+        };
         let alone = build_script
             && std::env::current_exe().is_ok_and(|exe| {
                 std::process::Command::new(exe)
-                    .env(ONE_MODEL, &file)
-                    .env(ONE_OUTPUT, &rust_file)
+                    .env(ONE_MODEL, &generated.model_file)
+                    .env(ONE_OUTPUT, &generated.rust_file)
                     .stdout(std::process::Stdio::null())
                     .stderr(std::process::Stdio::null())
                     .status()
                     .is_ok_and(|s| s.success())
             });
-        if !alone {
-            here.push(file);
-            continue;
+        if alone {
+            done.push(generated);
+        } else {
+            here.push((model, generated));
         }
-        done.push(Generated {
-            model_file: file,
-            rust_file,
-            type_name: model.type_name(),
-            q: model.coordinates.len(),
-            n: model.velocities.len(),
-        });
     }
-    for file in here {
-        match derive(&file) {
+    for (model, generated) in here {
+        match derive::derive(&model) {
             Ok(d) => {
-                let rust_file = out_dir.join(format!("{}.rs", d.model.name));
-                if let Err(e) = std::fs::write(&rust_file, emit::file(&d, Options::default())) {
-                    let mut cx = diag::Collector::new(&file, "");
+                let rust_file = &generated.rust_file;
+                if let Err(e) = std::fs::write(rust_file, emit::file(&d, Options::default())) {
+                    let mut cx = diag::Collector::new(&generated.model_file, "");
                     cx.error(ErrorKind::Io(format!("{}: {e}", rust_file.display())), None);
                     errors.push(cx.into_errors());
                     continue;
                 }
-                done.push(Generated {
-                    model_file: file,
-                    rust_file,
-                    type_name: d.model.type_name(),
-                    q: d.model.coordinates.len(),
-                    n: d.model.velocities.len(),
-                });
+                done.push(generated);
             }
             Err(e) => errors.push(e),
         }

@@ -65,3 +65,16 @@ pub fn scaled<M: Model<Q, N> + FromParams, const Q: usize, const N: usize>(facto
     }
     model
 }
+
+/// The built-in model files (`models/*.toml`), in name order: the order
+/// the build script derives them in.
+pub fn model_files() -> Vec<std::path::PathBuf> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    files
+}

@@ -115,13 +115,10 @@ impl Namer<'_> {
                 let (b, e) = p.get_base_exp();
                 self.visit(b).pow(e.to_owned())
             }
-            AtomView::Fun(f) if f.get_nargs() == 1 => {
-                let arg = f.iter().next().map(|x| self.visit(x));
-                match arg {
-                    Some(arg) => function!(f.get_symbol(), arg),
-                    None => a.to_owned(),
-                }
-            }
+            AtomView::Fun(f) if f.get_nargs() == 1 => match f.iter().next() {
+                Some(x) => function!(f.get_symbol(), self.visit(x)),
+                None => a.to_owned(),
+            },
             _ => a.to_owned(),
         }
     }

@@ -193,14 +193,10 @@ impl Compiler {
             ),
             _ => (0, per_call(p)),
         };
-        let mut best: Option<((usize, usize), Program)> = None;
-        for p in candidates {
-            let k = key(&p);
-            if best.as_ref().is_none_or(|(b, _)| k < *b) {
-                best = Some((k, p));
-            }
-        }
-        best.expect("at least one program").1
+        candidates
+            .into_iter()
+            .min_by_key(key)
+            .expect("at least one program")
     }
 
     /// As [`Compiler::program`], where the model has the quantity (an
