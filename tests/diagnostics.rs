@@ -5,15 +5,11 @@
 
 use std::path::Path;
 
+mod common;
+
 #[test]
 fn every_bad_model_gets_its_diagnostics() {
-    let dir = Path::new("tests/bad_models");
-    let mut files: Vec<_> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    files.sort();
+    let files = common::toml_files(Path::new("tests/bad_models"));
     assert!(files.len() >= 20, "the corpus has {} files", files.len());
     for file in files {
         let name = file.file_stem().unwrap().to_string_lossy().into_owned();

@@ -69,7 +69,11 @@ pub fn scaled<M: Model<Q, N> + FromParams, const Q: usize, const N: usize>(facto
 /// The built-in model files (`models/*.toml`), in name order: the order
 /// the build script derives them in.
 pub fn model_files() -> Vec<std::path::PathBuf> {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
+    toml_files(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models"))
+}
+
+/// The `*.toml` files in `dir`, in name order.
+pub fn toml_files(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
     let mut files: Vec<_> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().path())
