@@ -7,16 +7,16 @@
 //! - `bounce/{dormand_prince,taylor}/{100,1000,10000}`: the §3.2.1
 //!   nonholonomic pendulum from just after a bounce, through that many
 //!   bounces (throughput in bounces);
-//! - `rolling/{ball_wall_euler,ball_wall_quaternion}/{dormand_prince,taylor}`:
+//! - `rolling/{ball_wall_euler,ball_wall_quaternion}/{dormand_prince,taylor,taylor_order_28}`:
 //!   the §3.1 ball, its attitude in Euler angles or as a unit quaternion
 //!   (holonomic |e| = 1), driven into the wall by a uniform force, through
-//!   100 impacts;
+//!   100 impacts, and with Taylor's method also at a fixed order (28);
 //! - `chain/{chain_3,chain_8}/{dormand_prince,taylor}`: the n-link chain's
 //!   tip on the floor from the model file's start, through 100 impacts
 //!   (chain_3's q̈ in closed form, chain_8's by elimination; the motion is
 //!   chaotic, so the two methods' impacts are not the same ones);
-//! - `pendulum/{dormand_prince,taylor}`: the Cartesian pendulum (holonomic
-//!   rod) against its wall, through 100 impacts.
+//! - `pendulum/{dormand_prince,taylor,taylor_order_28}`: the Cartesian
+//!   pendulum (holonomic rod) against its wall, through 100 impacts.
 //!
 //! Before timing, each pair of runs is checked to meet the same number of
 //! collisions, and the steps, evaluations and errors of both are printed
@@ -42,8 +42,8 @@ mod bounce;
 mod cpu_time;
 use cpu_time::ThreadCpuTime;
 
-fn methods() -> [(&'static str, Settings); 2] {
-    [
+fn methods() -> Vec<(&'static str, Settings)> {
+    vec![
         (
             "dormand_prince",
             Settings {
@@ -59,6 +59,23 @@ fn methods() -> [(&'static str, Settings); 2] {
             },
         ),
     ]
+}
+
+/// [`methods`] and Taylor's method at a fixed order above the tolerance's
+/// (for the rolling balls, whose steps the radius of convergence bounds).
+fn with_fixed_order() -> Vec<(&'static str, Settings)> {
+    let mut m = methods();
+    m.push((
+        "taylor_order_28",
+        Settings {
+            integrator: Integrator::Taylor(Taylor {
+                fixed_order: Some(28),
+                ..Taylor::default()
+            }),
+            ..Settings::default()
+        },
+    ));
+    m
 }
 
 /// §3.2.1: just after a bounce at x = 0 with u = 2, v = 1.
@@ -181,8 +198,9 @@ fn paired<M: Surfaces<N>, const N: usize>(
     group: &str,
     m: &M,
     start: State<N>,
+    methods: &[(&'static str, Settings)],
 ) {
-    let runs: Vec<_> = methods()
+    let runs: Vec<_> = methods
         .iter()
         .map(|(name, s)| (*name, *s, run(m, start, *s)))
         .collect();
@@ -212,15 +230,34 @@ fn initial<M: Dynamics<N>, const N: usize>(m: &M) -> State<N> {
 
 fn rolling(c: &mut Criterion<ThreadCpuTime>) {
     let ball = BallWallEuler::default();
-    paired(c, "rolling/ball_wall_euler", &ball, initial(&ball));
+    let methods = with_fixed_order();
+    paired(
+        c,
+        "rolling/ball_wall_euler",
+        &ball,
+        initial(&ball),
+        &methods,
+    );
     let quat = BallWallQuaternion::default();
-    paired(c, "rolling/ball_wall_quaternion", &quat, initial(&quat));
+    paired(
+        c,
+        "rolling/ball_wall_quaternion",
+        &quat,
+        initial(&quat),
+        &methods,
+    );
 }
 
 fn chain(c: &mut Criterion<ThreadCpuTime>) {
     fn one<M: Surfaces<N> + Default, const N: usize>(c: &mut Criterion<ThreadCpuTime>) {
         let m = M::default();
-        paired(c, &format!("chain/{}", m.name()), &m, initial(&m));
+        paired(
+            c,
+            &format!("chain/{}", m.name()),
+            &m,
+            initial(&m),
+            &methods(),
+        );
     }
     one::<Chain3, 3>(c);
     one::<Chain8, 8>(c);
@@ -233,7 +270,7 @@ fn pendulum(c: &mut Criterion<ThreadCpuTime>) {
         q: [-0.8, -0.6],
         v: [0.0, 0.0],
     };
-    paired(c, "pendulum", &p, start);
+    paired(c, "pendulum", &p, start, &with_fixed_order());
 }
 
 criterion_group! {

@@ -15,6 +15,7 @@ use dalembert::runtime::simulate::{
     DormandPrince, Integrator, Residual, Rk4, Settings, Simulator, State, Taylor, admissible,
     residual,
 };
+use dalembert::runtime::taylor::MAX_ORDER;
 use dalembert_codegen::Derivation;
 use dalembert_codegen::interpret::Interpreted;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -58,6 +59,11 @@ pub struct SimulateArgs {
     /// default: the unit roundoff of f64, 2^-53).
     #[arg(long)]
     pub tolerance: Option<f64>,
+    /// A fixed order for Taylor's method (2 to 31; default: the
+    /// tolerance's, 20 at 2^-53). Above the tolerance's order the steps are
+    /// longer, where the radius of convergence bounds them.
+    #[arg(long)]
+    pub order: Option<usize>,
     /// NAME=VALUE for a parameter, a coordinate or a velocity (repeatable);
     /// the rest come from the model file (`[parameters]`, `[initial]`).
     #[arg(long = "set", value_name = "NAME=VALUE", value_parser = assignment)]
@@ -238,6 +244,11 @@ fn checked_spacing(args: &SimulateArgs) -> Result<f64, String> {
                 && !(tol > 0.0 && tol < 1.0)
             {
                 return Err(format!("--tolerance must be in (0, 1), not {tol}"));
+            }
+            if let Some(p) = args.order
+                && !(2..=MAX_ORDER).contains(&p)
+            {
+                return Err(format!("--order must be from 2 to {MAX_ORDER}, not {p}"));
             }
         }
     }
@@ -456,6 +467,7 @@ fn settings(args: &SimulateArgs) -> Settings {
         }),
         Method::Taylor => Integrator::Taylor(Taylor {
             tolerance: args.tolerance.unwrap_or(Taylor::default().tolerance),
+            fixed_order: args.order,
             ..Taylor::default()
         }),
     };

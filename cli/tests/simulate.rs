@@ -300,7 +300,8 @@ fn a_model_file_simulates_without_writing_rust() {
 
 /// `--integrator taylor` runs a built-in model and a model file (through
 /// the interpreter's series) to the same collisions as the default method,
-/// and a tolerance outside (0, 1) is refused.
+/// at the tolerance's order and at a fixed one, and a tolerance outside
+/// (0, 1) or an order beyond the series' capacity is refused.
 #[test]
 fn taylor_integrator_from_the_command_line() {
     for (model, name) in [
@@ -313,19 +314,17 @@ fn taylor_integrator_from_the_command_line() {
             model.to_string()
         };
         let mut collisions = Vec::new();
-        for integrator in ["dormand-prince", "taylor"] {
-            let dir = scratch(&format!("simulate-{name}-{integrator}"));
+        for (run, method) in [
+            ("dormand-prince", &["dormand-prince"][..]),
+            ("taylor", &["taylor"]),
+            ("taylor-28", &["taylor", "--order", "28"]),
+        ] {
+            let dir = scratch(&format!("simulate-{name}-{run}"));
             let out = dir.to_str().unwrap();
-            let (ok, stdout, stderr) = dalembert(&[
-                "simulate",
-                &model,
-                "--t-end",
-                "3",
-                "--integrator",
-                integrator,
-                "--out",
-                out,
-            ]);
+            let mut args = vec!["simulate", &model, "--t-end", "3", "--out", out];
+            args.push("--integrator");
+            args.extend(method);
+            let (ok, stdout, stderr) = dalembert(&args);
             assert!(ok, "{stdout}\n{stderr}");
             let csv = std::fs::read_to_string(dir.join(format!("{name}.csv"))).unwrap();
             let hits = csv.lines().skip(1).filter(|l| !l.ends_with(',')).count();
@@ -333,14 +332,17 @@ fn taylor_integrator_from_the_command_line() {
         }
         assert!(collisions[0] > 0, "{name}: {collisions:?}");
         assert_eq!(collisions[0], collisions[1], "{name}");
+        assert_eq!(collisions[0], collisions[2], "{name}");
     }
-    let (ok, _, stderr) = dalembert(&[
-        "simulate",
-        "ball_bounce",
-        "--integrator",
-        "taylor",
-        "--tolerance",
-        "2",
-    ]);
-    assert!(!ok && stderr.contains("--tolerance"), "{stderr}");
+    for (flag, value) in [("--tolerance", "2"), ("--order", "32"), ("--order", "1")] {
+        let (ok, _, stderr) = dalembert(&[
+            "simulate",
+            "ball_bounce",
+            "--integrator",
+            "taylor",
+            flag,
+            value,
+        ]);
+        assert!(!ok && stderr.contains(flag), "{flag} {value}: {stderr}");
+    }
 }

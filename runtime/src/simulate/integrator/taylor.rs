@@ -14,6 +14,13 @@ pub struct Taylor {
     /// The tolerance, absolute for components below 1 and relative above
     /// (Jorba & Zou's ε; the default is the unit roundoff of f64).
     pub tolerance: f64,
+    /// A fixed order (2 to [`MAX_ORDER`]) instead of the one the tolerance
+    /// asks for. The step is then the last two terms below the tolerance
+    /// (see [`Taylor::step`]), so an order above the tolerance's takes
+    /// longer steps: where the radius of convergence, not the tolerance,
+    /// bounds the step (near a coordinate singularity, say), fewer steps at
+    /// more work per step.
+    pub fixed_order: Option<usize>,
     /// Largest step allowed.
     pub max_step: f64,
 }
@@ -22,6 +29,7 @@ impl Default for Taylor {
     fn default() -> Self {
         Self {
             tolerance: f64::EPSILON / 2.0,
+            fixed_order: None,
             max_step: f64::INFINITY,
         }
     }
@@ -30,15 +38,23 @@ impl Default for Taylor {
 impl Taylor {
     /// Whether the settings are usable.
     pub fn valid(&self) -> bool {
-        self.tolerance > 0.0 && self.tolerance < 1.0 && self.max_step > 0.0
+        self.tolerance > 0.0
+            && self.tolerance < 1.0
+            && self.max_step > 0.0
+            && self
+                .fixed_order
+                .is_none_or(|p| (2..=MAX_ORDER).contains(&p))
     }
 
-    /// The order: ⌈−½ ln ε + 1⌉ (Jorba & Zou, eq. 3.8), at least 2 and at
-    /// most [`MAX_ORDER`] − 1 (the step size reads the coefficients of
-    /// order p − 1 and p).
+    /// The order: the fixed order if one is set, else ⌈−½ ln ε + 1⌉ (Jorba
+    /// & Zou, eq. 3.8), at least 2 and at most [`MAX_ORDER`] (the step size
+    /// reads the coefficients of order p − 1 and p).
     pub fn order(&self) -> usize {
-        let p = libm::ceil(-0.5 * libm::log(self.tolerance) + 1.0);
-        (p as usize).clamp(2, MAX_ORDER)
+        let p = match self.fixed_order {
+            Some(p) => p,
+            None => libm::ceil(-0.5 * libm::log(self.tolerance) + 1.0) as usize,
+        };
+        p.clamp(2, MAX_ORDER)
     }
 
     /// The lower order tried first where a step is likely to end at a wall
@@ -57,9 +73,11 @@ impl Taylor {
     /// (max(1, ‖x₀‖∞)/‖xⱼ‖∞)^(1/j)), both with the safety factor
     /// exp(−0.7/(p − 1)) heyoka uses; the norms are over every coordinate
     /// and velocity. At the order the tolerance asks for the asymptotic step
-    /// is the shorter; at a lower order (`low_order`) the first one is. A
-    /// series whose last two orders vanish (a polynomial motion) takes the
-    /// longest step.
+    /// is the shorter; at a lower order (`low_order`) the first one is. The
+    /// asymptotic step is Jorba & Zou's for the order the tolerance asks
+    /// for, so with a [`fixed_order`](Self::fixed_order) only the first
+    /// estimate bounds the step. A series whose last two orders vanish (a
+    /// polynomial motion) takes the longest step.
     pub fn step<const N: usize>(&self, s: &Series<N>) -> f64 {
         Plan::new(*self).step(s)
     }
@@ -73,6 +91,9 @@ pub(crate) struct Plan {
     pub order: usize,
     pub low_order: usize,
     log_tolerance: f64,
+    /// ln of the asymptotic step's factor, e⁻², or +∞ where only the
+    /// truncation bounds the step (a fixed order).
+    log_asymptotic: f64,
 }
 
 impl Plan {
@@ -82,6 +103,10 @@ impl Plan {
             order: method.order(),
             low_order: method.low_order(),
             log_tolerance: libm::log(method.tolerance),
+            log_asymptotic: match method.fixed_order {
+                Some(_) => f64::INFINITY,
+                None => -2.0,
+            },
         }
     }
 
@@ -101,7 +126,7 @@ impl Plan {
             }
         }
         let scale = norms[0].max(1.0);
-        let log_eps = self.log_tolerance;
+        let (log_eps, asymptotic) = (self.log_tolerance, self.log_asymptotic);
         // In logarithms: ln h = ln ρⱼ + min(ln ε / j, −2) − 0.7/(p − 1),
         // a logarithm per order read and one exponential per step.
         let log_step = |j: usize, x: f64| {
@@ -109,7 +134,7 @@ impl Plan {
                 f64::INFINITY
             } else {
                 let j = j as f64;
-                libm::log(scale / x) / j + (log_eps / j).min(-2.0)
+                libm::log(scale / x) / j + (log_eps / j).min(asymptotic)
             }
         };
         let log_h = log_step(p - 1, norms[1]).min(log_step(p, norms[2]));
@@ -134,6 +159,19 @@ mod tests {
             ..t
         };
         assert_eq!(loose.order(), 8);
+        let fixed = Taylor {
+            fixed_order: Some(28),
+            ..loose
+        };
+        assert_eq!((fixed.order(), fixed.low_order()), (28, 14));
+        assert!(fixed.valid());
+        for p in [0, 1, MAX_ORDER + 1] {
+            let bad = Taylor {
+                fixed_order: Some(p),
+                ..t
+            };
+            assert!(!bad.valid(), "order {p}");
+        }
     }
 
     /// For x(t) = 1/(1 − t) (x₀ = 1, all coefficients 1) the radius of
@@ -163,6 +201,21 @@ mod tests {
         assert!(libm::fabs(h8 - want) <= 1e-14 * want, "{h8} {want}");
         let rho8 = libm::pow(1.0 / 8.0, 1.0 / 7.0).min(libm::pow(1.0 / 9.0, 1.0 / 8.0));
         assert!(h8 < rho8 / e2 * libm::exp(-0.7 / 7.0));
+        // A fixed order above the tolerance's: the last two terms alone, so
+        // the step is longer than ρ/e² (the tolerance's order would cap it
+        // there).
+        s.order = 30;
+        let fixed = Taylor {
+            fixed_order: Some(30),
+            ..t
+        };
+        let h30 = fixed.step(&s);
+        let trunc = libm::pow(eps / 30.0, 1.0 / 29.0).min(libm::pow(eps / 31.0, 1.0 / 30.0));
+        let want = trunc * libm::exp(-0.7 / 29.0);
+        assert!(libm::fabs(h30 - want) <= 1e-14 * want, "{h30} {want}");
+        let rho30 = libm::pow(1.0 / 30.0, 1.0 / 29.0).min(libm::pow(1.0 / 31.0, 1.0 / 30.0));
+        assert!(h30 > 2.0 * rho30 / e2 * libm::exp(-0.7 / 29.0));
+        assert!(t.step(&s) < 1.0001 * rho30 / e2 * libm::exp(-0.7 / 29.0));
         // A polynomial motion: no limit but the longest step.
         let mut line = Series::<1>::at(&[0.0], &[1.0]);
         line.q[0][1] = 1.0;
