@@ -7,23 +7,28 @@
 mod common;
 
 use std::f64::consts::{E, PI};
-use std::path::PathBuf;
+use std::path::Path;
 
 use dalembert_codegen::derive::Derivation;
 use dalembert_codegen::quantity::Quantity;
 
-/// Writes `text` as a model file in a fresh temporary directory.
-fn model_file(name: &str, text: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("dalembert-language-{}", std::process::id()));
+/// Writes `text` as a model file `name.toml` in a temporary directory of
+/// its own, runs `f` on its path and removes the directory.
+fn with_model_file<T>(name: &str, text: &str, f: impl FnOnce(&Path) -> T) -> T {
+    let dir =
+        std::env::temp_dir().join(format!("dalembert-language-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(format!("{name}.toml"));
     std::fs::write(&path, text).unwrap();
-    path
+    let out = f(&path);
+    std::fs::remove_dir_all(&dir).unwrap();
+    out
 }
 
 fn derive(name: &str, text: &str) -> Derivation {
-    let path = model_file(name, text);
-    dalembert_codegen::derive(&path).unwrap_or_else(|e| panic!("{name}: {e}"))
+    with_model_file(name, text, |path| {
+        dalembert_codegen::derive(path).unwrap_or_else(|e| panic!("{name}: {e}"))
+    })
 }
 
 /// The model's function `q` at `inputs` (parameters, coordinates, velocities).
@@ -220,7 +225,9 @@ fn every_function_and_constant_reaches_the_emitted_programs() {
         }
     }
     // The same programs in f32.
-    let f32_code = dalembert_codegen::generate_f32(&model_file("everything", EVERYTHING)).unwrap();
+    let f32_code = with_model_file("everything", EVERYTHING, |path| {
+        dalembert_codegen::generate_f32(path).unwrap()
+    });
     assert!(f32_code.contains("sqrtf") && f32_code.contains("expf"));
 }
 

@@ -53,6 +53,7 @@ fn generate_in_child() {
         let file = dir.join("prelude.toml");
         std::fs::write(&file, PRELUDE).unwrap();
         dalembert_codegen::derive(&file).unwrap_or_else(|e| panic!("prelude: {e}"));
+        std::fs::remove_dir_all(&dir).unwrap();
     }
     let model = std::env::var_os("DALEMBERT_MODEL").map_or_else(chain_3, Into::into);
     let code = dalembert_codegen::generate(&model).unwrap_or_else(|e| panic!("{e}"));
@@ -77,7 +78,9 @@ fn generated(model: Option<&Path>, prelude: bool, tag: &str) -> String {
     }
     let status = child.status().unwrap();
     assert!(status.success(), "the child process failed");
-    std::fs::read_to_string(out).unwrap()
+    let code = std::fs::read_to_string(&out).unwrap();
+    std::fs::remove_file(&out).unwrap();
+    code
 }
 
 /// chain_3 generated alone and generated after a model that made its names
