@@ -223,6 +223,16 @@ fn checked_spacing(args: &SimulateArgs) -> Result<f64, String> {
             args.t_end / every
         ));
     }
+    if !matches!(args.integrator, Method::Taylor) {
+        for (flag, given) in [
+            ("--tolerance", args.tolerance.is_some()),
+            ("--order", args.order.is_some()),
+        ] {
+            if given {
+                return Err(format!("{flag} applies to --integrator taylor only"));
+            }
+        }
+    }
     match args.integrator {
         Method::Rk4 => {
             positive("--step", args.step)?;

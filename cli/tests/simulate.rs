@@ -300,8 +300,9 @@ fn a_model_file_simulates_without_writing_rust() {
 
 /// `--integrator taylor` runs a built-in model and a model file (through
 /// the interpreter's series) to the same collisions as the default method,
-/// at the tolerance's order and at a fixed one, and a tolerance outside
-/// (0, 1) or an order beyond the series' capacity is refused.
+/// at the tolerance's order and at a fixed one; a tolerance outside (0, 1),
+/// an order beyond the series' capacity, or either with another method is
+/// refused.
 #[test]
 fn taylor_integrator_from_the_command_line() {
     for (model, name) in [
@@ -344,5 +345,13 @@ fn taylor_integrator_from_the_command_line() {
             value,
         ]);
         assert!(!ok && stderr.contains(flag), "{flag} {value}: {stderr}");
+    }
+    // Taylor's settings with another method: refused, not ignored.
+    for (flag, value) in [("--tolerance", "1e-12"), ("--order", "28")] {
+        let (ok, _, stderr) = dalembert(&["simulate", "ball_bounce", flag, value]);
+        assert!(
+            !ok && stderr.contains("applies to --integrator taylor only"),
+            "{flag}: {stderr}"
+        );
     }
 }
