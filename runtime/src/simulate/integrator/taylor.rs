@@ -127,8 +127,9 @@ impl Plan {
         }
         let scale = norms[0].max(1.0);
         let (log_eps, asymptotic) = (self.log_tolerance, self.log_asymptotic);
-        // In logarithms: ln h = ln ρⱼ + min(ln ε / j, −2) − 0.7/(p − 1),
-        // a logarithm per order read and one exponential per step.
+        // In logarithms: ln h = ln ρⱼ + min(ln ε / j, −2) − 0.7/(p − 1)
+        // (without the −2 at a fixed order), a logarithm per order read and
+        // one exponential per step.
         let log_step = |j: usize, x: f64| {
             if x == 0.0 {
                 f64::INFINITY
