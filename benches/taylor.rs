@@ -18,8 +18,8 @@
 //! - `pendulum/{dormand_prince,taylor,taylor_order_28}`: the Cartesian
 //!   pendulum (holonomic rod) against its wall, through 100 impacts.
 //!
-//! Before timing, each pair of runs is checked to meet the same number of
-//! collisions, and the steps, evaluations and errors of both are printed
+//! Before timing, the runs of each group are checked to meet the same
+//! number of collisions, and the steps, evaluations and errors of each are printed
 //! (bounce-instant and energy errors against the exact §3.2.1 motion).
 //!
 //! Run: `cargo bench --bench taylor`.
@@ -62,7 +62,8 @@ fn methods() -> Vec<(&'static str, Settings)> {
 }
 
 /// [`methods`] and Taylor's method at a fixed order above the tolerance's
-/// (for the rolling balls, whose steps the radius of convergence bounds).
+/// (for the rolling balls and the pendulum, whose steps the radius of
+/// convergence bounds).
 fn with_fixed_order() -> Vec<(&'static str, Settings)> {
     let mut m = methods();
     m.push((
