@@ -6,7 +6,11 @@
 //!   `surface_series` along it, the state at one instant on the series;
 //! - `bounce/{dormand_prince,taylor}/{100,1000,10000}`: the §3.2.1
 //!   nonholonomic pendulum from just after a bounce, through that many
-//!   bounces (throughput in bounces);
+//!   bounces (throughput in bounces), with the attitude in Euler angles
+//!   (`ball_bounce`);
+//! - `bounce_omega/*`: the same with the centre and ω as the state
+//!   (`ball_bounce_omega`, no attitude: the flight is a parabola with ω
+//!   constant);
 //! - `rolling/{ball_wall_euler,ball_wall_quaternion}/{dormand_prince,taylor,taylor_order_28}`:
 //!   the §3.1 ball, its attitude in Euler angles or as a unit quaternion
 //!   (holonomic |e| = 1), driven into the wall by a uniform force, through
@@ -28,7 +32,8 @@ use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use dalembert::models::{
-    BallBounce, BallWallEuler, BallWallQuaternion, Chain3, Chain8, PendulumWall, ball_bounce,
+    BallBounce, BallBounceOmega, BallWallEuler, BallWallQuaternion, Chain3, Chain8, PendulumWall,
+    ball_bounce,
 };
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
@@ -85,11 +90,16 @@ fn bounce_start(ball: &BallBounce) -> State<6> {
     State { t: 0.0, q, v }
 }
 
-/// Runs `bounces` bounces; returns the stats, the worst relative error of
-/// a bounce instant and the worst relative energy error at a bounce.
-fn bounce_run(ball: &BallBounce, settings: Settings, bounces: u64) -> (Stats, f64, f64) {
-    let start = bounce_start(ball);
-    let g = ball.params().g;
+/// Runs `bounces` bounces of `ball` from `start` under gravity `g`;
+/// returns the stats, the worst relative error of a bounce instant and the
+/// worst relative energy error at a bounce.
+fn bounce_run<M: Surfaces<6>>(
+    ball: &M,
+    start: State<6>,
+    g: f64,
+    settings: Settings,
+    bounces: u64,
+) -> (Stats, f64, f64) {
     let e0 = ball.energy(&start.q, &start.v);
     let mut sim = Simulator::new(ball, start, settings).unwrap();
     let (mut n, mut dt, mut de) = (0u64, 0.0f64, 0.0f64);
@@ -138,24 +148,39 @@ fn series(c: &mut Criterion<ThreadCpuTime>) {
     g.finish();
 }
 
-fn bounce(c: &mut Criterion<ThreadCpuTime>) {
-    let ball = BallBounce::default();
-    let mut group = c.benchmark_group("bounce");
+/// The §3.2.1 runs of one model in the group `name`.
+fn bounce_group<M: Surfaces<6>>(
+    c: &mut Criterion<ThreadCpuTime>,
+    name: &str,
+    ball: &M,
+    start: State<6>,
+    g: f64,
+) {
+    let mut group = c.benchmark_group(name);
     for bounces in [100u64, 1000, 10_000] {
-        for (name, settings) in methods() {
-            let (stats, dt, de) = bounce_run(&ball, settings, bounces);
+        for (method, settings) in methods() {
+            let (stats, dt, de) = bounce_run(ball, start, g, settings, bounces);
             eprintln!(
-                "bounce/{name}/{bounces}: {} steps, {} evaluations, bounce-instant error {dt:.1e}, energy error {de:.1e}",
+                "{name}/{method}/{bounces}: {} steps, {} evaluations, bounce-instant error {dt:.1e}, energy error {de:.1e}",
                 stats.steps, stats.evaluations
             );
             group.throughput(Throughput::Elements(bounces));
             group.sample_size(if bounces >= 10_000 { 10 } else { 20 });
-            group.bench_function(format!("{name}/{bounces}"), |b| {
-                b.iter(|| bounce_run(black_box(&ball), settings, bounces))
+            group.bench_function(format!("{method}/{bounces}"), |b| {
+                b.iter(|| bounce_run(black_box(ball), start, g, settings, bounces))
             });
         }
     }
     group.finish();
+}
+
+fn bounce(c: &mut Criterion<ThreadCpuTime>) {
+    let ball = BallBounce::default();
+    bounce_group(c, "bounce", &ball, bounce_start(&ball), ball.params().g);
+    let omega = BallBounceOmega::default();
+    let (q, v) = bounce::after_bounce_omega(&omega);
+    let start = State { t: 0.0, q, v };
+    bounce_group(c, "bounce_omega", &omega, start, omega.params().g);
 }
 
 /// Impacts in the `rolling` and `pendulum` runs.

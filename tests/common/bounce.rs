@@ -4,7 +4,7 @@
 
 #![allow(dead_code)] // each includer uses some of these
 
-use dalembert::models::{BallBounce, ball_bounce};
+use dalembert::models::{BallBounce, BallBounceOmega, ball_bounce, ball_bounce_omega};
 use dalembert::runtime::Walls;
 
 /// The centre's speed up (u) and along x (v) at the bounce.
@@ -25,4 +25,22 @@ pub fn before_bounce(ball: &BallBounce) -> ([f64; 6], [f64; 6]) {
 pub fn after_bounce(ball: &BallBounce) -> ([f64; 6], [f64; 6]) {
     let (q, v_minus) = before_bounce(ball);
     (q, ball.collide(ball_bounce::Wall::Floor, &q, &v_minus))
+}
+
+/// The same in `ball_bounce_omega`'s state, the centre and ω (where
+/// ω = (θ', −ψ', φ') above): q and v⁻ = (−v, 0, −u, 0, r m v / J, 0).
+pub fn before_bounce_omega(ball: &BallBounceOmega) -> ([f64; 6], [f64; 6]) {
+    let p = ball.params();
+    let q = [0.0, 0.0, p.r, 0.0, 0.0, 0.0];
+    let v_minus = [-V, 0.0, -U, 0.0, p.r * p.m * V / p.J, 0.0];
+    (q, v_minus)
+}
+
+/// The same just after the bounce: q and v⁺.
+pub fn after_bounce_omega(ball: &BallBounceOmega) -> ([f64; 6], [f64; 6]) {
+    let (q, v_minus) = before_bounce_omega(ball);
+    (
+        q,
+        ball.collide(ball_bounce_omega::Wall::Floor, &q, &v_minus),
+    )
 }
