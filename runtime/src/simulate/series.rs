@@ -222,8 +222,16 @@ fn first_root(c: &Coefficients, order: usize, h: f64, departing: bool) -> Result
     // Trailing zeros cost evaluations and say nothing (a flight's f is
     // often of degree 2).
     let order = degree(c, order);
-    // f's derivative, for the turning points (rarely needed: made on demand).
+    // f's turning point in [a, b] (needed after every bounce, where the
+    // departure is followed over the top): for a parabola c₀ + c₁τ + c₂τ²
+    // its vertex −c₁/(2c₂), else a root of f's derivative, made on demand.
     let turn = |a: f64, b: f64| {
+        if order == 2 {
+            let top = -c[1] / (2.0 * c[2]);
+            if top >= a && top <= b {
+                return top;
+            }
+        }
         let mut rate = [0.0; CAPACITY];
         for k in 0..order {
             rate[k] = (k + 1) as f64 * c[k + 1];
@@ -376,6 +384,10 @@ mod tests {
         assert!((tau - want).abs() <= 2.0 * f64::EPSILON * want);
         // The same state not departing is at the wall already.
         assert_eq!(first_root(&c, 2, 1.0, false), Ok(Some(0.0)));
+        // Leaving from just beyond the wall and turning back before f is
+        // positive: grazing, reported at the parabola's vertex.
+        let c = poly(&[-1e-9, 1e-5, -1.0]);
+        assert_eq!(first_root(&c, 2, 1.0, true), Err(5e-6));
     }
 
     /// The closed-form start of the root search: the root in the bracket,
