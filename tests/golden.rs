@@ -19,8 +19,8 @@ fn generated_files_match_their_snapshots() {
     for file in files {
         let stem = file.file_stem().unwrap().to_string_lossy().into_owned();
         let built = Path::new(env!("OUT_DIR")).join(format!("{stem}.rs"));
-        let code = std::fs::read_to_string(&built)
-            .unwrap_or_else(|e| panic!("{}: {e}", built.display()));
+        let code =
+            std::fs::read_to_string(&built).unwrap_or_else(|e| panic!("{}: {e}", built.display()));
         assert!(code.starts_with("// @generated"));
         insta::assert_snapshot!(format!("generated_{stem}"), code);
     }
