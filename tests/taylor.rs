@@ -1,216 +1,24 @@
-//! Taylor's method: the generated series of the motion and of each wall's
-//! f, against known series (the ball in flight, the pendulum) and against
-//! themselves on every model (the series re-expanded at a later instant is
-//! the series computed there; the energy is constant along the series;
-//! coefficient 1 of q̇ is the closed-form q̈; the wall's series is f along
-//! the state's series), then the simulator with Taylor's method on the
-//! paper's §3.2.1 run, the Cartesian pendulum's elliptic period and the
-//! rolling ball meeting the wall.
+//! Taylor's method in the simulator, on the models' generated series
+//! (checked in `tests/taylor_series.rs`): the paper's §3.2.1 run in two
+//! states of the ball, the Cartesian pendulum's elliptic period and its
+//! wall hits, the rolling ball meeting the wall, and the typed errors of a
+//! model without series and of a non-finite series.
 
-use dalembert::for_each_model;
 use dalembert::models::*;
 use dalembert::runtime::dynamics::DynamicsError;
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
     Integrator, Settings, SimError, Simulator, State, Stats, Taylor,
 };
-use dalembert::runtime::taylor::{CAPACITY, Series, eval};
+use dalembert::runtime::taylor::Series;
 
 #[path = "common/bounce.rs"]
 mod bounce;
-mod common;
-use common::{for_random_cases, onto_kernel};
 
 fn taylor() -> Settings {
     Settings {
         integrator: Integrator::Taylor(Taylor::default()),
         ..Settings::default()
-    }
-}
-
-/// Binomial coefficient C(n, k) as f64.
-fn binomial(n: usize, k: usize) -> f64 {
-    (0..k).fold(1.0, |acc, i| acc * (n - i) as f64 / (i + 1) as f64)
-}
-
-/// The checks of one model at one random case (parameters, q, v).
-fn check_series<M: Surfaces<N>, const N: usize>(
-    m: &M,
-    q: &[f64; N],
-    v: [f64; N],
-) -> Result<(), proptest::test_runner::TestCaseError> {
-    let v = onto_kernel(&m.constraints(q), v);
-    let order = 16;
-    let mut s = Series::at(q, &v);
-    if !m.taylor_series(&mut s, order) {
-        return Ok(());
-    }
-    let Some(acc) = m.closed_form_accelerations(q, &v) else {
-        panic!("a model with series has q̈ in closed form");
-    };
-    let scale = 1.0 + acc.iter().chain(&v).fold(0.0f64, |a, x| a.max(x.abs()));
-    if scale.is_nan() || scale >= 1e3 {
-        // Near a coordinate singularity: nothing to compare at this case.
-        return Ok(());
-    }
-    assert_eq!(s.order, order);
-    for i in 0..N {
-        assert_eq!(s.q[i][1], v[i]);
-        let want = acc[i] / 1.0;
-        assert!(
-            (s.v[i][1] - want).abs() <= 1e-13 * scale,
-            "q̈ {i}: {} vs {want}",
-            s.v[i][1]
-        );
-        assert!((s.q[i][2] - s.v[i][1] / 2.0).abs() <= 1e-15 * scale);
-    }
-    // Re-expanded at τ, the series is the series computed at τ:
-    // x_k(τ) = Σ_j C(j, k) x_j τ^(j−k), for the orders that the
-    // truncation leaves accurate: τ a tenth of the step Taylor's method
-    // would take (its radius of convergence estimated from the last
-    // coefficients, over e²), compared at the size of the sum's terms (and
-    // at rounding of the state's scale, for coefficients that vanish).
-    let tau = 0.1 * Taylor::default().step(&s).min(1.0 / scale);
-    let (q1, v1) = s.state(tau);
-    let mut s1 = Series::at(&q1, &v1);
-    assert!(m.taylor_series(&mut s1, order));
-    let shifted = |c: &[f64; CAPACITY], k: usize| -> (f64, f64) {
-        (k..=order)
-            .map(|j| binomial(j, k) * c[j] * tau.powi((j - k) as i32))
-            .fold((0.0, 0.0), |(sum, size), x| (sum + x, size + x.abs()))
-    };
-    for k in 0..6 {
-        for i in 0..N {
-            for (c, c1, what) in [(&s.q[i], &s1.q[i], "q"), (&s.v[i], &s1.v[i], "v")] {
-                let ((want, size), got) = (shifted(c, k), c1[k]);
-                assert!(
-                    (got - want).abs() <= 1e-11 * size + 1e-15 * scale.powi(k as i32 + 1),
-                    "{} {what}{i} order {k}: {got} vs {want}",
-                    m.name()
-                );
-            }
-        }
-    }
-    // The energy is a constant of the motion: constant along the series.
-    let e0 = m.energy(q, &v);
-    for j in 1..=4 {
-        let (qq, vv) = s.state(j as f64 * tau);
-        let e = m.energy(&qq, &vv);
-        assert!(
-            (e - e0).abs() <= 1e-10 * (1.0 + e0.abs()) * scale * scale,
-            "{}: energy {e} vs {e0}",
-            m.name()
-        );
-    }
-    // Each wall's series is f along the state's series.
-    let mut f = [0.0; CAPACITY];
-    for &w in m.walls() {
-        assert!(m.surface_series(w, &s, &mut f));
-        for j in 0..=4 {
-            let t = j as f64 * tau;
-            let (qq, _) = s.state(t);
-            let want = m.surface(w, &qq);
-            let got = eval(&f, s.order, t);
-            assert!(
-                (got - want).abs() <= 1e-11 * (1.0 + want.abs()),
-                "{} wall {w:?} at {t}: {got} vs {want}",
-                m.name()
-            );
-        }
-    }
-    Ok(())
-}
-
-macro_rules! series_test {
-    ($module:ident, $ty:ident, 0, $n:literal) => {};
-    ($module:ident, $ty:ident, $q:literal, $n:literal) => {
-        #[test]
-        fn $module() {
-            for_random_cases::<$ty, $n, $n>(64, |m, q, v| check_series(m, q, v));
-        }
-    };
-}
-
-mod series_agree_with_themselves {
-    use super::*;
-    for_each_model!(series_test);
-}
-
-/// A model has series exactly where q̈ is written out (every built-in
-/// model with coordinates: in closed form, or by elimination).
-#[test]
-fn series_exist_where_closed_forms_do() {
-    fn both<M: Dynamics<N> + Default, const N: usize>() -> (bool, bool) {
-        let m = M::default();
-        let (q, v) = ([0.5; N], [0.0; N]);
-        let mut s = Series::at(&q, &v);
-        (
-            m.taylor_series(&mut s, 4),
-            m.closed_form_accelerations(&q, &v).is_some(),
-        )
-    }
-    macro_rules! same {
-        ($module:ident, $ty:ident, 0, $n:literal) => {};
-        ($module:ident, $ty:ident, $q:literal, $n:literal) => {
-            let (series, closed) = both::<$ty, $n>();
-            assert_eq!(series, closed, "{}", stringify!($ty));
-        };
-    }
-    for_each_model!(same);
-}
-
-/// The ball in flight: its centre's series is the parabola (order 2 and
-/// no more), its spin about a fixed axis keeps ω constant, and the floor's
-/// series is z − r.
-#[test]
-fn ball_in_flight_is_a_parabola() {
-    let ball = BallBounce::default();
-    let (r, g) = (ball.params().r, ball.params().g);
-    let q = [0.3, -0.2, 2.0, 0.0, std::f64::consts::FRAC_PI_2, 0.0];
-    let v = [1.0, 0.5, 2.0, 0.0, 0.0, 5.0];
-    let mut s = Series::at(&q, &v);
-    assert!(ball.taylor_series(&mut s, 20));
-    for k in 2..=20 {
-        assert_eq!(s.q[0][k], 0.0, "x, order {k}");
-        assert_eq!(s.q[1][k], 0.0, "y, order {k}");
-    }
-    assert_eq!(s.q[2][2], -g / 2.0);
-    for k in 3..=20 {
-        assert_eq!(s.q[2][k], 0.0, "z, order {k}");
-    }
-    // φ = φ' = 0, θ = π/2, ψ' = 5: ω = (0, −5, 0) is a rotation about the
-    // fixed y axis, ψ(t) = 5t: the series of ψ is 5τ exactly to rounding.
-    for k in 2..=20 {
-        assert!(s.q[5][k].abs() < 1e-14, "ψ, order {k}: {}", s.q[5][k]);
-        assert!(s.q[4][k].abs() < 1e-14, "θ, order {k}: {}", s.q[4][k]);
-    }
-    let mut f = [0.0; CAPACITY];
-    assert!(ball.surface_series(ball_bounce::Wall::Floor, &s, &mut f));
-    assert_eq!(&f[..3], &[2.0 - r, 2.0, -g / 2.0]);
-}
-
-/// The Cartesian pendulum's series, against the angle's: x = l sin θ,
-/// y = −l cos θ with θ̈ = −(g/l) sin θ, whose series at rest at θ₀ begins
-/// θ₀ − (g/l) sin θ₀ τ²/2 + (g/l)² sin θ₀ cos θ₀ τ⁴/24.
-#[test]
-fn pendulum_series_is_the_angles() {
-    let p = PendulumWall::default();
-    let (l, g) = (p.params().l, p.params().g);
-    let th0: f64 = 0.9;
-    let q = [l * th0.sin(), -l * th0.cos()];
-    let mut s = Series::at(&q, &[0.0, 0.0]);
-    assert!(p.taylor_series(&mut s, 12));
-    let w = g / l;
-    let theta = |t: f64| {
-        th0 - w * th0.sin() * t * t / 2.0 + w * w * th0.sin() * th0.cos() * t.powi(4) / 24.0
-    };
-    for t in [0.001, 0.002, 0.004] {
-        let (qq, _) = s.state(t);
-        let want = [l * theta(t).sin(), -l * theta(t).cos()];
-        for i in 0..2 {
-            // The angle's series is cut after τ⁴: its error is O(τ⁶).
-            assert!((qq[i] - want[i]).abs() < 1e-12, "{t}: {qq:?} vs {want:?}");
-        }
     }
 }
 
