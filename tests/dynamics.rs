@@ -3,9 +3,10 @@
 //! they were derived: the energy T + V is constant along the motion (the
 //! reactions do no work on admissible velocities), A q̇ stays zero to second
 //! order, both by finite differences of the generated T, V and A; and the
-//! analytic motion of the Chaplygin sleigh (puck). The generated closed
-//! forms of q̈ are checked against the equations themselves, on every model,
-//! at random parameters and states.
+//! analytic motion of the Chaplygin sleigh (puck); the §3.2 ball's three
+//! models meet the floor by one map. The generated closed forms of q̈ are
+//! checked against the equations themselves, on every model, at random
+//! parameters and states.
 
 use dalembert::for_each_model;
 use dalembert::models::*;
@@ -236,4 +237,53 @@ fn the_initial_state_follows_the_parameters() {
         assert_eq!(ball.surface(ball_bounce::Wall::Floor, &q), 0.0);
     }
     assert_eq!(BallBounce::INITIAL_COORDINATES[2], 0.5);
+}
+
+/// The §3.2 ball meets the floor by one map in all three of its models:
+/// `ball_floor` (the paper's velocities v, ω), `ball_bounce_omega` (the
+/// centre and ω as coordinates' rates) and `ball_bounce` (Euler angles, at
+/// φ = ψ = 0, θ = π/2, where ω = (θ', −ψ', φ')), at random velocities and
+/// parameters: the velocities after the collision agree to rounding.
+#[test]
+fn the_three_models_of_the_ball_meet_the_floor_alike() {
+    let mut seed = 7u64;
+    for _ in 0..200 {
+        let mut draw = |lo: f64, hi: f64| lo + (hi - lo) * lcg(&mut seed);
+        let (m, r, j) = (draw(0.5, 2.0), draw(0.2, 1.0), draw(0.05, 0.5));
+        let floor = BallFloor::with_params(ball_floor::Params { m, r, J: j });
+        let omega = BallBounceOmega::with_params(ball_bounce_omega::Params {
+            m,
+            r,
+            J: j,
+            ..Default::default()
+        });
+        let euler = BallBounce::with_params(ball_bounce::Params {
+            m,
+            r,
+            J: j,
+            ..Default::default()
+        });
+        // (v, ω), falling onto the floor.
+        let mut v: [f64; 6] = core::array::from_fn(|_| draw(-3.0, 3.0));
+        v[2] = -draw(0.1, 3.0);
+        let paper = floor.floor_collide(&[], &v);
+        let q_omega = [0.0, 0.0, r, 0.0, 0.0, 0.0];
+        let by_omega = omega.collide(ball_bounce_omega::Wall::Floor, &q_omega, &v);
+        // In Euler angles: (φ', θ', ψ') = (ω_z, ω_x, −ω_y).
+        let q_euler = [0.0, 0.0, r, 0.0, std::f64::consts::FRAC_PI_2, 0.0];
+        let v_euler = [v[0], v[1], v[2], v[5], v[3], -v[4]];
+        let e = euler.collide(ball_bounce::Wall::Floor, &q_euler, &v_euler);
+        let by_euler = [e[0], e[1], e[2], e[4], -e[5], e[3]];
+        let scale = v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        for i in 0..6 {
+            assert!(
+                (by_omega[i] - paper[i]).abs() <= 1e-14 * scale,
+                "centre and ω, component {i}: {by_omega:?} vs {paper:?}"
+            );
+            assert!(
+                (by_euler[i] - paper[i]).abs() <= 1e-13 * scale,
+                "Euler angles, component {i}: {by_euler:?} vs {paper:?}"
+            );
+        }
+    }
 }
