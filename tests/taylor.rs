@@ -26,14 +26,15 @@ fn taylor() -> Settings {
 /// for 10⁴ bounces: the ball bounces every 2u/g, alternately at x = 0 and
 /// x = 2uv/g. Asserts the bounce instants against 4n/g and the energy to
 /// 1e-15 relative, the centre's position within `position`, and one step
-/// per flight; returns the stats.
+/// per flight; returns the stats and every bounce (its instant and the
+/// state after it), the start first.
 fn bounces_with_taylor<M: Surfaces<6>>(
     ball: &M,
     (q, q_dot): ([f64; 6], [f64; 6]),
     r: f64,
     g: f64,
     position: f64,
-) -> Stats {
+) -> (Stats, Vec<Bounce>) {
     let start = State {
         t: 0.0,
         q,
@@ -46,6 +47,7 @@ fn bounces_with_taylor<M: Surfaces<6>>(
     let bounces = 10_000;
     let mut n = 0usize;
     let mut worst = [0.0f64; 3];
+    let mut bounced = vec![(0.0, q, q_dot)];
     let stats = sim
         .run((bounces as f64 + 0.5) * flight, |s| {
             if let Some(c) = s.collision {
@@ -56,6 +58,7 @@ fn bounces_with_taylor<M: Surfaces<6>>(
                 worst[0] = worst[0].max((c.t - exact).abs() / exact);
                 worst[1] = worst[1].max((c.q[0] - x).abs() + c.q[1].abs() + (c.q[2] - r).abs());
                 worst[2] = worst[2].max((ball.energy(&c.q, &c.v_plus) - e0).abs() / e0);
+                bounced.push((c.t, c.q, c.v_plus));
             }
             true
         })
@@ -74,26 +77,73 @@ fn bounces_with_taylor<M: Surfaces<6>>(
     assert!(worst[0] <= 1e-15, "relative time error {}", worst[0]);
     assert!(worst[1] <= position, "position error {}", worst[1]);
     assert!(worst[2] <= 1e-15, "energy error {}", worst[2]);
-    stats
+    (stats, bounced)
 }
 
-/// §3.2.1 with Taylor's method, the attitude in Euler angles
-/// (`ball_bounce`). The flight is a parabola, which the series holds
-/// exactly, and each bounce is the root of that parabola on the step,
-/// found to rounding. Observed: one step per bounce, the 10⁴-th bounce
-/// instant within 2.2e-16 relative of 4n/g, |Δq| 7.8e-16, energy within
-/// 8.2e-16 relative; the goals asked for are 1e-15 in time and energy,
-/// which the assertions hold.
+/// A bounce: its instant and the state after it.
+type Bounce = (f64, [f64; 6], [f64; 6]);
+
+/// For each flight, the lowest order whose own step reaches the next
+/// bounce: the order a lower-order trial needs to take it. The step of the
+/// series truncated at order p is Taylor's step at the fixed order p
+/// (below order 19 the tolerance's asymptotic bound, e⁻², is the looser
+/// one, so it is the step the trials take).
+fn orders_needed<M: Surfaces<6>>(ball: &M, bounced: &[Bounce]) -> Vec<usize> {
+    let t = Taylor::default();
+    bounced
+        .windows(2)
+        .map(|w| {
+            let ((t0, q, v), (t1, _, _)) = (w[0], w[1]);
+            let mut s = Series::at(&q, &v);
+            ball.taylor_series(&mut s, t.order());
+            (2..=t.order())
+                .find(|&p| {
+                    s.order = p;
+                    let fixed = Taylor {
+                        fixed_order: Some(p),
+                        ..t
+                    };
+                    fixed.step(&s) >= t1 - t0
+                })
+                .unwrap_or(t.order())
+        })
+        .collect()
+}
+
+/// The trials' orders are learnt: each flight taken by a lower-order step
+/// is taken at an order no higher than the highest any flight so far has
+/// needed (`orders_needed`), or than the first trials' order
+/// ([`Taylor::low_order`]; the trials only learn upwards). Every other
+/// series (the trials that failed, at most 5, and the full-order series
+/// after them) is counted at the full order, and the last step, to the end
+/// of the run, at the highest need.
+fn assert_orders_learnt<M: Surfaces<6>>(ball: &M, stats: &Stats, bounced: &[Bounce]) {
+    let t = Taylor::default();
+    let mut highest = t.low_order() as u64;
+    let mut bound = 0;
+    for need in orders_needed(ball, bounced) {
+        highest = highest.max(need as u64);
+        bound += highest;
+    }
+    bound += highest;
+    // One evaluation is the simulator's first q̈, not a series.
+    let others = stats.evaluations - 1 - stats.low_order_steps;
+    bound += t.order() as u64 * others;
+    assert!(highest < t.order() as u64, "{highest}");
+    assert!(stats.series_orders <= bound, "{bound}: {stats:?}");
+}
+
 #[test]
 fn nonholonomic_pendulum_with_taylor() {
     let ball = BallBounce::default();
     let p = ball.params();
-    let stats = bounces_with_taylor(&ball, bounce::after_bounce(&ball), p.r, p.g, 1e-13);
+    let (stats, bounced) = bounces_with_taylor(&ball, bounce::after_bounce(&ball), p.r, p.g, 1e-13);
     // Each flight is taken on the series of a lower order (nearly
     // polynomial: even that reaches the floor), but for the few in which
-    // the run learns the order it needs.
+    // the run learns the order it needs, and no higher than that.
     assert!(stats.low_order_steps + 5 >= stats.steps, "{stats:?}");
     assert!(stats.evaluations <= stats.steps + 1 + 5, "{stats:?}");
+    assert_orders_learnt(&ball, &stats, &bounced);
 }
 
 /// The same with the centre and ω as the state (`ball_bounce_omega`): the
@@ -109,9 +159,11 @@ fn nonholonomic_pendulum_with_taylor() {
 fn nonholonomic_pendulum_in_centre_and_omega_with_taylor() {
     let ball = BallBounceOmega::default();
     let p = ball.params();
-    let stats = bounces_with_taylor(&ball, bounce::after_bounce_omega(&ball), p.r, p.g, 1e-12);
+    let (stats, bounced) =
+        bounces_with_taylor(&ball, bounce::after_bounce_omega(&ball), p.r, p.g, 1e-12);
     assert_eq!(stats.low_order_steps, stats.steps, "{stats:?}");
     assert_eq!(stats.evaluations, stats.steps + 1, "{stats:?}");
+    assert_orders_learnt(&ball, &stats, &bounced);
 }
 
 /// The free Cartesian pendulum (wall out of reach) with Taylor's method:

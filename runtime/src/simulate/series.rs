@@ -39,13 +39,17 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     /// lower order: if its own step, short enough for the tolerance at that
     /// order, already reaches a collision or the end of the run, no order
     /// could step further, and the step is taken on it. Otherwise the
-    /// series is computed again to the full order, and the lower order
-    /// tried next is raised by 2 (from [`Taylor::low_order`] up to the full
-    /// order, where the trials stop): each run learns the lowest order its
-    /// flights need, and a motion whose steps never reach a wall wastes a
-    /// few trials only. A flight in uniform gravity is the case in point:
-    /// its motion is nearly polynomial, so a lower order reaches the floor
-    /// at a fraction of the cost.
+    /// series is computed again to the full order, and the lower order is
+    /// raised (from [`Taylor::low_order`] up to the full order, where the
+    /// trials stop). If the full series meets a wall at τ, it is raised to
+    /// the lowest order whose own step, read off the same coefficients,
+    /// reaches τ ([`Plan::step_at`]); else by 2. So each run learns the
+    /// lowest order its flights need, within one order, in a trial or two,
+    /// and a motion whose steps never reach a wall wastes a few trials
+    /// only. A flight in uniform gravity is the case in point: its motion
+    /// is nearly polynomial, so a lower order reaches the floor at a
+    /// fraction of the cost, and the cost of a series grows as the square
+    /// of its order.
     ///
     /// [`Taylor::low_order`]: super::Taylor::low_order
     pub(super) fn series_step(
@@ -55,17 +59,25 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     ) -> Result<Step<M::Wall, N>, SimError<M::Wall>> {
         let t0 = self.state.t;
         let left = (t_end - t0) - self.t_low;
-        if self.low_order_first && self.low_order < method.order {
+        let tried = self.low_order_first && self.low_order < method.order;
+        if tried {
             let h = self.series(method, self.low_order, left)?;
             let found = self.first_collision(h)?;
             if found.is_some() || h >= left {
                 self.stats.low_order_steps += 1;
                 return self.take(h, t_end, found);
             }
-            self.low_order += 2;
         }
         let h = self.series(method, method.order, left)?;
         let found = self.first_collision(h)?;
+        if tried {
+            self.low_order = match found {
+                Some((_, tau)) => (self.low_order + 1..method.order)
+                    .find(|&p| method.step_at(&self.series, p) >= tau)
+                    .unwrap_or(method.order),
+                None => self.low_order + 2,
+            };
+        }
         self.low_order_first = found.is_some();
         self.take(h, t_end, found)
     }
@@ -79,6 +91,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             return Err(SimError::NoSeries);
         }
         self.stats.evaluations += 1;
+        self.stats.series_orders += order as u64;
         // Non-finite coefficients are caught where the step is evaluated
         // (`finite` below): Horner's scheme carries an infinity or a NaN in
         // any coefficient into the value at any τ > 0, so checking the 2N

@@ -106,6 +106,10 @@ pub struct Stats {
     /// Steps of Taylor's method taken on a series of lower order than the
     /// tolerance's (see [`super::Taylor::low_order`]).
     pub low_order_steps: u64,
+    /// Taylor's method: the sum of the orders of every series computed.
+    /// Over `evaluations` it is the mean order, the measure of the work:
+    /// each order runs every operation of the series once.
+    pub series_orders: u64,
 }
 
 /// Why the simulation stopped.

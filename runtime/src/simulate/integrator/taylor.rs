@@ -112,7 +112,14 @@ impl Plan {
 
     /// [`Taylor::step`].
     pub fn step<const N: usize>(&self, s: &Series<N>) -> f64 {
-        let p = s.order;
+        self.step_at(s, s.order)
+    }
+
+    /// The step the series `s` truncated at order p (2 ≤ p ≤ `s.order`)
+    /// would take: the coefficients up to p are the same whatever order the
+    /// series was computed to, so a longer series tells what a shorter one
+    /// would have done.
+    pub fn step_at<const N: usize>(&self, s: &Series<N>, p: usize) -> f64 {
         // ‖x₀‖∞, ‖x_{p−1}‖∞ and ‖xₚ‖∞ in one pass; a NaN is passed over
         // (the state evaluated on the step catches it).
         let mut norms = [0.0f64; 3];
