@@ -205,6 +205,14 @@ pub fn recip_finish(c: &Coefficients, a: &Coefficients, h: f64, k: usize) -> f64
     -(a[k] * c[0] + h) * c[0]
 }
 
+/// Coefficient k ≥ 1 of c = a/b from the [`history`] h of b with c:
+/// cₖ = (aₖ − bₖc₀ − h)/b₀, one convolution where 1/b then a·(1/b) take
+/// two.
+#[inline(always)]
+pub fn div_finish(c: &Coefficients, a: &Coefficients, b: &Coefficients, h: f64, k: usize) -> f64 {
+    (a[k] - b[k] * c[0] - h) / b[0]
+}
+
 /// Coefficient k ≥ 1 of c = √a from the [`history`] h of c with itself.
 #[inline(always)]
 pub fn sqrt_finish(c: &Coefficients, a: &Coefficients, h: f64, k: usize) -> f64 {
@@ -271,6 +279,16 @@ pub fn recip(c: &Coefficients, a: &Coefficients, k: usize) -> f64 {
         return 1.0 / a[0];
     }
     recip_finish(c, a, history(a, c, k), k)
+}
+
+/// Coefficient k of c = a/b, from a's and b's coefficients and c's below
+/// k.
+#[inline]
+pub fn div(c: &Coefficients, a: &Coefficients, b: &Coefficients, k: usize) -> f64 {
+    if k == 0 {
+        return a[0] / b[0];
+    }
+    div_finish(c, a, b, history(b, c, k), k)
 }
 
 /// Coefficient k of c = √a, from a's coefficients and c's below k.
@@ -347,14 +365,16 @@ mod tests {
     }
 
     /// Each recurrence against the closed-form series of its function
-    /// around t₀ = 0.3 (sin, cos, exp, 1/(1+t), √(1+t), (1+t)^α, ln(1+t)).
+    /// around t₀ = 0.3 (sin, cos, exp, 1/(1+t), √(1+t), (1+t)^α, ln(1+t),
+    /// and (0.3 + t)/(1 + t) = 1 − 0.7/(1 + t)).
     #[test]
     fn recurrences_match_known_series() {
         let p = 20;
         let x = var(0.3);
         let one_plus = var(1.0);
         let (mut s, mut c, mut e) = ([0.0; CAPACITY], [0.0; CAPACITY], [0.0; CAPACITY]);
-        let (mut r, mut q, mut w, mut l) = (
+        let (mut r, mut q, mut w, mut l, mut quotient) = (
+            [0.0; CAPACITY],
             [0.0; CAPACITY],
             [0.0; CAPACITY],
             [0.0; CAPACITY],
@@ -367,6 +387,7 @@ mod tests {
             q[k] = sqrt(&q, &one_plus, k);
             w[k] = power(&w, &one_plus, -1.5, k);
             l[k] = log(&l, &one_plus, k);
+            quotient[k] = div(&quotient, &x, &one_plus, k);
         }
         let mut fact = 1.0;
         let mut binom_half = 1.0;
@@ -394,6 +415,8 @@ mod tests {
             assert!(close(w[k], binom_alpha), "power {k}");
             let ln = if k == 0 { 0.0 } else { -sign / k as f64 };
             assert!(close(l[k], ln), "log {k}");
+            let ratio = if k == 0 { 0.3 } else { -0.7 * sign };
+            assert!(close(quotient[k], ratio), "div {k}");
         }
     }
 

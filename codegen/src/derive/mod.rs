@@ -182,15 +182,18 @@ impl Compiler {
     /// on a tie: per call (parameter-only work done once) for every
     /// function but q̈. Taylor's method spends its time in q̈'s series,
     /// where a convolution costs a loop over the orders so far and any
-    /// other series operation one step, so for q̈ the fewer convolutions
-    /// decide first, then the per-call cost.
+    /// other series operation one step, so for q̈ the series' work at the
+    /// default order ([`Transform::cost`]) decides first, then the per-call
+    /// cost.
+    ///
+    /// [`Transform::cost`]: crate::program::Transform::cost
     fn cheapest(&self, quantity: Quantity, candidates: Vec<Program>) -> Program {
         let per_call = |p: &Program| p.split(self.params, 0).op_counts(p).0.cost();
+        let order = dalembert_runtime::simulate::Taylor::default().order();
         let key = |p: &Program| match quantity {
-            Quantity::Accelerations => (
-                p.taylor(self.params, self.coords).convolutions(),
-                per_call(p),
-            ),
+            Quantity::Accelerations => {
+                (p.taylor(self.params, self.coords).cost(order), per_call(p))
+            }
             _ => (0, per_call(p)),
         };
         candidates

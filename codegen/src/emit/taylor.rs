@@ -270,6 +270,10 @@ fn order_zero(d: &Ctx, t: &Transform) -> TokenStream {
                 quote! { #dst[0] = #tay::square(&#a, 0); }
             }
             Op::Recip { dst, a } => unary(quote! { #tay::recip }, *dst, *a, None),
+            Op::Div { dst, a, b } => {
+                let (dst, a, b) = (series(*dst), series(*a), series(*b));
+                quote! { #dst[0] = #tay::div(&#dst, &#a, &#b, 0); }
+            }
             Op::Sqrt { dst, a } => unary(quote! { #tay::sqrt }, *dst, *a, None),
             Op::Exp { dst, a } => unary(quote! { #tay::exp }, *dst, *a, None),
             Op::Log { dst, a } => unary(quote! { #tay::log }, *dst, *a, None),
@@ -324,6 +328,11 @@ fn order_k(d: &Ctx, t: &Transform) -> (TokenStream, TokenStream) {
                     let (dst, a) = (series(*dst), series(*a));
                     let h = history(quote! { #a[j] * #dst[r] });
                     quote! { #dst[k] = #tay::recip_finish(&#dst, &#a, #h, k); }
+                }
+                Op::Div { dst, a, b } => {
+                    let (dst, a, b) = (series(*dst), series(*a), series(*b));
+                    let h = history(quote! { #b[j] * #dst[r] });
+                    quote! { #dst[k] = #tay::div_finish(&#dst, &#a, &#b, #h, k); }
                 }
                 Op::Sqrt { dst, a } => {
                     let (dst, a) = (series(*dst), series(*a));

@@ -93,6 +93,7 @@ impl Transform {
                 Op::Mul { a, b, .. } => tay::mul(get(*a), get(*b), k),
                 Op::Square { a, .. } => tay::square(get(*a), k),
                 Op::Recip { dst, a } => tay::recip(get(*dst), get(*a), k),
+                Op::Div { dst, a, b } => tay::div(get(*dst), get(*a), get(*b), k),
                 Op::Sqrt { dst, a } => tay::sqrt(get(*dst), get(*a), k),
                 Op::Power { dst, a, alpha } => tay::power(get(*dst), get(*a), *alpha, k),
                 Op::Exp { dst, a } => tay::exp(get(*dst), get(*a), k),
