@@ -43,10 +43,9 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     /// raised (from [`Taylor::low_order`] up to the full order, where the
     /// trials stop). If the full series meets a wall at τ, it is raised to
     /// the lowest order whose own step, read off the same coefficients,
-    /// reaches τ ([`Plan::step_at`]); else by 2. So each run learns the
-    /// lowest order its flights need, within one order, in a trial or two,
-    /// and a motion whose steps never reach a wall wastes a few trials
-    /// only. A flight in uniform gravity is the case in point: its motion
+    /// reaches τ ([`Plan::step_at`]); else by 2. So each run learns, in a
+    /// trial or two, the lowest order its flights need so far, and a motion
+    /// whose steps never reach a wall wastes a few trials only. A flight in uniform gravity is the case in point: its motion
     /// is nearly polynomial, so a lower order reaches the floor at a
     /// fraction of the cost, and the cost of a series grows as the square
     /// of its order.

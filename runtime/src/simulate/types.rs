@@ -106,9 +106,12 @@ pub struct Stats {
     /// Steps of Taylor's method taken on a series of lower order than the
     /// tolerance's (see [`super::Taylor::low_order`]).
     pub low_order_steps: u64,
-    /// Taylor's method: the sum of the orders of every series computed.
-    /// Over `evaluations` it is the mean order, the measure of the work:
-    /// each order runs every operation of the series once.
+    /// Taylor's method: the sum of the orders of every series computed
+    /// (zero with the other methods). Over the series computed
+    /// (`evaluations` less the one q̈ at the start) it is their mean order,
+    /// the measure of the work: each order runs every operation of the
+    /// series once, and each convolution sums more products the higher the
+    /// order.
     pub series_orders: u64,
 }
 

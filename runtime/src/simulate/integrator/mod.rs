@@ -1,12 +1,12 @@
 //! Integration methods between collisions. Each is one file. The
 //! Runge–Kutta methods have their tableau, dense output and step-size
-//! control and implement [`Method`] over evaluations of (q̇, q̈); Taylor's
+//! control and implement `Method` over evaluations of (q̇, q̈); Taylor's
 //! method steps along the model's own series (`taylor.rs`, and the
 //! simulator's `series.rs` for its events). [`Integrator`] names them in
 //! [`super::Settings`].
 //!
-//! Adding a Runge–Kutta method: a file here implementing [`Method`], a
-//! variant of [`Integrator`] and of [`RungeKutta`], and its arm in
+//! Adding a Runge–Kutta method: a file here implementing `Method`, a
+//! variant of [`Integrator`] and of `RungeKutta`, and its arm in
 //! `with_method!`.
 
 mod dense;
