@@ -17,6 +17,7 @@ use std::collections::HashMap;
 use super::{Func, Instr, Program, Slot, constant};
 
 mod evaluate;
+mod quotients;
 pub use evaluate::Evaluation;
 
 /// A series the transform reads or writes.
@@ -58,7 +59,7 @@ pub enum Op {
     Square { dst: Series, a: Series },
     /// 1/a.
     Recip { dst: Series, a: Series },
-    /// a/b (a product with a reciprocal, fused: see [`fuse_quotients`]).
+    /// a/b (a product with a reciprocal, fused: see `quotients.rs`).
     Div { dst: Series, a: Series, b: Series },
     /// √a.
     Sqrt { dst: Series, a: Series },
@@ -140,7 +141,7 @@ impl<'a> Builder<'a> {
                     .unwrap_or_else(|| Term::Number(constant(&mut self.numbers.consts, 0.0)))
             })
             .collect();
-        let (ops, temps) = fuse_quotients(self.ops, &mut outputs);
+        let (ops, temps) = quotients::fuse(self.ops, &mut outputs);
         Transform {
             numbers: self.numbers,
             temps,
@@ -310,55 +311,6 @@ impl<'a> Builder<'a> {
     }
 }
 
-/// Every product with a reciprocal, a·(1/b), made a quotient a/b: one
-/// convolution where the reciprocal and the product take two. A
-/// reciprocal no longer read is dropped, and the temporaries are numbered
-/// again in the order they are written. Returns the ops and how many
-/// temporaries they use.
-fn fuse_quotients(ops: Vec<Op>, outputs: &mut [Term]) -> (Vec<Op>, usize) {
-    let recips: HashMap<Series, Series> = ops
-        .iter()
-        .filter_map(|op| match op {
-            Op::Recip { dst, a } => Some((*dst, *a)),
-            _ => None,
-        })
-        .collect();
-    let fused: Vec<Op> = ops
-        .into_iter()
-        .map(|op| match op {
-            Op::Mul { dst, a, b } => match (recips.get(&a), recips.get(&b)) {
-                (_, Some(&den)) => Op::Div { dst, a, b: den },
-                (Some(&den), None) => Op::Div { dst, a: b, b: den },
-                (None, None) => op,
-            },
-            _ => op,
-        })
-        .collect();
-    let mut read: Vec<Series> = fused.iter().flat_map(Op::reads).collect();
-    read.extend(outputs.iter().filter_map(|t| match t {
-        Term::Series(s) => Some(*s),
-        Term::Number(_) => None,
-    }));
-    let kept: Vec<Op> = fused
-        .into_iter()
-        .filter(|op| !matches!(op, Op::Recip { dst, .. } if !read.contains(dst)))
-        .collect();
-    let mut renumbered = HashMap::new();
-    for s in kept.iter().flat_map(Op::writes) {
-        let next = renumbered.len();
-        renumbered.entry(s).or_insert(Series::Temp(next));
-    }
-    let rename = |s: Series| renumbered.get(&s).copied().unwrap_or(s);
-    for t in outputs.iter_mut() {
-        if let Term::Series(s) = t {
-            *s = rename(*s);
-        }
-    }
-    let mut ops = kept;
-    ops.iter_mut().for_each(|op| op.rename(&rename));
-    (ops, renumbered.len())
-}
-
 /// `ins` writing `dst` from `sources` (its own, renamed).
 fn with_sources(ins: &Instr, dst: Slot, sources: &[Slot]) -> Instr {
     match ins {
@@ -378,43 +330,6 @@ impl Op {
         match self {
             Op::SinCos { sin, cos, .. } => vec![*sin, *cos],
             _ => self.dst().into_iter().collect(),
-        }
-    }
-
-    /// The series it reads (its own lower coefficients not counted).
-    pub fn reads(&self) -> Vec<Series> {
-        match self {
-            Op::Add { series, .. } => series.clone(),
-            Op::Mul { a, b, .. } | Op::Div { a, b, .. } => vec![*a, *b],
-            Op::Scale { a, .. }
-            | Op::Square { a, .. }
-            | Op::Recip { a, .. }
-            | Op::Sqrt { a, .. }
-            | Op::Power { a, .. }
-            | Op::Exp { a, .. }
-            | Op::Log { a, .. }
-            | Op::SinCos { a, .. } => vec![*a],
-        }
-    }
-
-    /// Replaces each series it reads or writes by the one `rename` gives.
-    fn rename(&mut self, r: &impl Fn(Series) -> Series) {
-        match self {
-            Op::Add { dst, series, .. } => {
-                *dst = r(*dst);
-                series.iter_mut().for_each(|s| *s = r(*s));
-            }
-            Op::Mul { dst, a, b } | Op::Div { dst, a, b } => {
-                (*dst, *a, *b) = (r(*dst), r(*a), r(*b));
-            }
-            Op::Scale { dst, a, .. }
-            | Op::Square { dst, a }
-            | Op::Recip { dst, a }
-            | Op::Sqrt { dst, a }
-            | Op::Power { dst, a, .. }
-            | Op::Exp { dst, a }
-            | Op::Log { dst, a } => (*dst, *a) = (r(*dst), r(*a)),
-            Op::SinCos { sin, cos, a } => (*sin, *cos, *a) = (r(*sin), r(*cos), r(*a)),
         }
     }
 
@@ -554,56 +469,6 @@ mod tests {
         for j in 1..=10 {
             let tau = 0.02 * j as f64;
             assert!((energy(tau) - energy(0.0)).abs() < 1e-14, "{tau}");
-        }
-    }
-
-    /// A product with a reciprocal is one quotient: sin(x)·x⁻¹ is a sin/cos
-    /// pair and a division (no reciprocal left, temporaries numbered
-    /// without gaps), and its series is sin(x)/x's along x(t) = 2 + t.
-    #[test]
-    fn products_with_reciprocals_are_quotients() {
-        let x = Slot::Input(0);
-        let p = Program {
-            inputs: 1,
-            consts: vec![],
-            instrs: vec![
-                Instr::Fun(Slot::Temp(0), Func::Sin, x),
-                Instr::Pow(Slot::Temp(1), x, -1),
-                Instr::Mul(Slot::Out(0), vec![Slot::Temp(1), Slot::Temp(0)]),
-            ],
-            outputs: 1,
-        };
-        let tr = p.taylor(0, 1);
-        assert_eq!(
-            tr.ops,
-            vec![
-                Op::SinCos {
-                    sin: Series::Temp(0),
-                    cos: Series::Temp(1),
-                    a: Series::Q(0)
-                },
-                Op::Div {
-                    dst: Series::Temp(2),
-                    a: Series::Temp(0),
-                    b: Series::Q(0)
-                },
-            ]
-        );
-        assert_eq!((tr.temps, tr.convolutions()), (3, 2));
-        // To order 20: 19·18/2 products in each history, 20 finishes each.
-        assert_eq!(tr.cost(20), 2 * 171 + 2 * 20);
-        assert_eq!(tr.outputs, vec![Term::Series(Series::Temp(2))]);
-        let mut e = Evaluation {
-            q: vec![[0.0; tay::CAPACITY]],
-            v: vec![],
-            temps: vec![],
-        };
-        e.q[0][0] = 2.0;
-        e.q[0][1] = 1.0;
-        let c = tr.along(&[], &mut e, 25);
-        for tau in [0.0, 0.1, -0.2, 0.3] {
-            let (got, want) = (tay::eval(&c, 25, tau), (2.0 + tau).sin() / (2.0 + tau));
-            assert!((got - want).abs() <= 1e-15, "{tau}: {got} {want}");
         }
     }
 
