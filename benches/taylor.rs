@@ -11,15 +11,17 @@
 //! - `bounce_omega/*`: the same with the centre and ω as the state
 //!   (`ball_bounce_omega`, no attitude: the flight is a parabola with ω
 //!   constant);
-//! - `rolling/{ball_wall_euler,ball_wall_quaternion}/{dormand_prince,taylor,taylor_order_28}`:
+//! - `rolling/{ball_wall_euler,ball_wall_quaternion}/{dormand_prince,taylor,taylor_order_20,taylor_order_28}`:
 //!   the §3.1 ball, its attitude in Euler angles or as a unit quaternion
 //!   (holonomic |e| = 1), driven into the wall by a uniform force, through
-//!   100 impacts, and with Taylor's method also at a fixed order (28);
-//! - `chain/{chain_3,chain_8}/{dormand_prince,taylor}`: the n-link chain's
+//!   100 impacts, and with Taylor's method also at fixed orders (20, the
+//!   tolerance's, and 28; `taylor` is at the order the simulator picks
+//!   from the model's series work);
+//! - `chain/{chain_3,chain_8}/{dormand_prince,taylor,taylor_order_20}`: the n-link chain's
 //!   tip on the floor from the model file's start, through 100 impacts
 //!   (chain_3's q̈ in closed form, chain_8's by elimination; the motion is
 //!   chaotic, so the two methods' impacts are not the same ones);
-//! - `pendulum/{dormand_prince,taylor,taylor_order_28}`: the Cartesian
+//! - `pendulum/{dormand_prince,taylor,taylor_order_20,taylor_order_28}`: the Cartesian
 //!   pendulum (holonomic rod) against its wall, through 100 impacts.
 //!
 //! Before timing, the runs of each group are checked to meet the same
@@ -66,21 +68,28 @@ fn methods() -> Vec<(&'static str, Settings)> {
     ]
 }
 
-/// [`methods`] and Taylor's method at a fixed order above the tolerance's
-/// (for the rolling balls and the pendulum, whose steps the radius of
-/// convergence bounds).
-fn with_fixed_order() -> Vec<(&'static str, Settings)> {
+/// [`methods`] and Taylor's method at fixed orders: the tolerance's (20,
+/// where the simulator would otherwise pick the order from the model's
+/// series work), and `extra` ones.
+fn with_fixed_orders(extra: &[usize]) -> Vec<(&'static str, Settings)> {
     let mut m = methods();
-    m.push((
-        "taylor_order_28",
-        Settings {
-            integrator: Integrator::Taylor(Taylor {
-                fixed_order: Some(28),
-                ..Taylor::default()
-            }),
-            ..Settings::default()
-        },
-    ));
+    for &p in [20].iter().chain(extra) {
+        let name = match p {
+            20 => "taylor_order_20",
+            28 => "taylor_order_28",
+            _ => unreachable!("name the order {p}"),
+        };
+        m.push((
+            name,
+            Settings {
+                integrator: Integrator::Taylor(Taylor {
+                    fixed_order: Some(p),
+                    ..Taylor::default()
+                }),
+                ..Settings::default()
+            },
+        ));
+    }
     m
 }
 
@@ -232,8 +241,12 @@ fn paired<M: Surfaces<N>, const N: usize>(
         .collect();
     let mut g = c.benchmark_group(group);
     for (name, settings, (stats, de)) in runs {
+        let order = Simulator::new(m, start, settings)
+            .unwrap()
+            .taylor_order()
+            .map_or(String::new(), |p| format!(" (order {p})"));
         eprintln!(
-            "{group}/{name}: {} steps, {} evaluations, {} collisions by t = {:.3}, energy error {de:.1e}",
+            "{group}/{name}{order}: {} steps, {} evaluations, {} collisions by t = {:.3}, energy error {de:.1e}",
             stats.steps,
             stats.evaluations,
             stats.collisions,
@@ -256,7 +269,7 @@ fn initial<M: Dynamics<N>, const N: usize>(m: &M) -> State<N> {
 
 fn rolling(c: &mut Criterion<ThreadCpuTime>) {
     let ball = BallWallEuler::default();
-    let methods = with_fixed_order();
+    let methods = with_fixed_orders(&[28]);
     paired(
         c,
         "rolling/ball_wall_euler",
@@ -282,7 +295,7 @@ fn chain(c: &mut Criterion<ThreadCpuTime>) {
             &format!("chain/{}", m.name()),
             &m,
             initial(&m),
-            &methods(),
+            &with_fixed_orders(&[]),
         );
     }
     one::<Chain3, 3>(c);
@@ -296,7 +309,7 @@ fn pendulum(c: &mut Criterion<ThreadCpuTime>) {
         q: [-0.8, -0.6],
         v: [0.0, 0.0],
     };
-    paired(c, "pendulum", &p, start, &with_fixed_order());
+    paired(c, "pendulum", &p, start, &with_fixed_orders(&[28]));
 }
 
 criterion_group! {

@@ -4,7 +4,7 @@
 //! An instantaneous model (`Q = 0`, the paper's §3) implements only the
 //! first two: it has no motion and no surfaces.
 
-use crate::taylor::{Coefficients, Series};
+use crate::taylor::{Coefficients, Series, SeriesWork};
 use crate::{Rows, Values, linalg};
 
 /// What every model has: names, parameters, the mass matrix and the
@@ -183,5 +183,13 @@ pub trait Surfaces<const N: usize>: Dynamics<N> + Walls<N, N> {
     fn surface_series(&self, wall: Self::Wall, series: &Series<N>, out: &mut Coefficients) -> bool {
         let _ = (wall, series, out);
         false
+    }
+
+    /// The work per order of [`Dynamics::taylor_series`] and of the walls'
+    /// [`Surfaces::surface_series`], from which Taylor's method picks the
+    /// order that costs least per unit of time. `None` (the default):
+    /// unknown, and the method keeps the order its tolerance asks for.
+    fn series_work(&self) -> Option<SeriesWork> {
+        None
     }
 }

@@ -44,6 +44,40 @@ pub const RECIPROCALS: [f64; CAPACITY + 1] = {
     r
 };
 
+/// The work of one series program per order, as the generator counts it:
+/// a convolution sums k − 1 products at order k, and every operation is
+/// finished once per order.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Work {
+    /// Series operations per order.
+    pub operations: usize,
+    /// Of them, convolutions (a product, a quotient, a function's
+    /// recurrence: a sum over the coefficients so far).
+    pub convolutions: usize,
+}
+
+impl Work {
+    /// Multiply-adds to compute `orders` orders (0 to `orders` − 1):
+    /// c·(n − 1)(n − 2)/2 + o·n.
+    pub fn multiply_adds(&self, orders: usize) -> f64 {
+        let n = orders as f64;
+        self.convolutions as f64 * (n - 1.0).max(0.0) * (n - 2.0).max(0.0) / 2.0
+            + self.operations as f64 * n
+    }
+}
+
+/// What a model's series cost: the motion's (q̈'s program, whose orders 0
+/// to p − 1 give the series of order p) and every wall's f along it, summed
+/// ([`crate::Surfaces::series_work`]). Taylor's method picks its order from
+/// it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SeriesWork {
+    /// `motion_series`.
+    pub motion: Work,
+    /// The walls' `surface_series`, summed over the walls.
+    pub walls: Work,
+}
+
 /// An intermediate series of which generated code only ever reads the
 /// coefficient of the order it is computing (a sum's or a product's result
 /// that no recurrence reads back): it keeps that coefficient alone, and

@@ -62,9 +62,10 @@ pub struct SimulateArgs {
     /// default: the unit roundoff of f64, 2^-53).
     #[arg(long)]
     pub tolerance: Option<f64>,
-    /// A fixed order for Taylor's method (2 to 31; default: the
-    /// tolerance's, 20 at 2^-53). Above the tolerance's order the steps are
-    /// longer, where the radius of convergence bounds them.
+    /// A fixed order for Taylor's method (2 to 31; default: the one that
+    /// costs least per unit of time by the model's series work, at least
+    /// the tolerance's, 20 at 2^-53). Above the tolerance's order the steps
+    /// are longer, where the radius of convergence bounds them.
     #[arg(long)]
     pub order: Option<usize>,
     /// NAME=VALUE for a parameter, a coordinate or a velocity (repeatable);
@@ -464,8 +465,11 @@ fn summary<M: Surfaces<N>, const N: usize>(
     secs: f64,
 ) {
     let stats = sim.stats();
+    let order = sim
+        .taylor_order()
+        .map_or(String::new(), |p| format!(" at order {p}"));
     println!(
-        "{}: t = 0 → {} with {:?}",
+        "{}: t = 0 → {} with {:?}{order}",
         model.name(),
         sim.state().t,
         args.integrator

@@ -68,7 +68,21 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
     }
     let (dynamics, surfaces) = (methods(Capability::Dynamics), methods(Capability::Surfaces));
     let (motion_series, surface_series) = match super::taylor::transforms(d) {
-        Some(_) => {
+        Some((motion, walls)) => {
+            let work = |(operations, convolutions): (usize, usize)| {
+                let (o, c) = (
+                    Literal::usize_unsuffixed(operations),
+                    Literal::usize_unsuffixed(convolutions),
+                );
+                quote! { ::dalembert_runtime::taylor::Work { operations: #o, convolutions: #c } }
+            };
+            let motion_work = work(super::taylor::counts(&motion));
+            let walls_work = work(
+                walls
+                    .iter()
+                    .map(super::taylor::counts)
+                    .fold((0, 0), |(o, c), (wo, wc)| (o + wo, c + wc)),
+            );
             let arms = d.walls.iter().zip(&variants).map(|(w, v)| {
                 let f = format_ident!("{}_surface_series", w.name);
                 quote! { Wall::#v => self.#f(series, out) }
@@ -91,6 +105,13 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
                     ) -> bool {
                         match wall { #(#arms,)* }
                         true
+                    }
+                    #[inline]
+                    fn series_work(&self) -> Option<::dalembert_runtime::taylor::SeriesWork> {
+                        Some(::dalembert_runtime::taylor::SeriesWork {
+                            motion: #motion_work,
+                            walls: #walls_work,
+                        })
                     }
                 },
             )

@@ -173,11 +173,12 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
             .map_err(|error| SimError::Dynamics { t: start.t, error })?;
         let mut stats = Stats::default();
         let f0 = derivative(model, &mut stats, start.t, &y)?;
-        let engine = settings.integrator.engine();
-        let (proposal, low_order) = match engine {
+        let mut engine = settings.integrator.engine();
+        let (proposal, low_order) = match &mut engine {
             Engine::RungeKutta(m) => (m.initial_step(&y, &f0), 0),
             Engine::Taylor(t) => {
                 series::offered(model, &start)?;
+                *t = t.fitted(model.series_work(), N, model.walls().len());
                 (f64::INFINITY, t.low_order)
             }
         };
@@ -211,6 +212,15 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
     /// The model simulated.
     pub fn model(&self) -> &'m M {
         self.model
+    }
+
+    /// The order Taylor's method steps at for this model
+    /// ([`Taylor::order_for`]); `None` for the other methods.
+    pub fn taylor_order(&self) -> Option<usize> {
+        match self.engine {
+            Engine::Taylor(t) => Some(t.order),
+            Engine::RungeKutta(_) => None,
+        }
     }
 
     /// Energy and constraint residuals of the current state.

@@ -41,14 +41,15 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     /// could step further, and the step is taken on it. Otherwise the
     /// series is computed again to the full order, and the lower order is
     /// raised (from [`Taylor::low_order`] up to the full order, where the
-    /// trials stop). If the full series meets a wall at τ, it is raised to
-    /// the lowest order whose own step, read off the same coefficients,
-    /// reaches τ ([`Plan::step_at`]); else by 2. So each run learns, in a
-    /// trial or two, the lowest order its flights need so far, and a motion
-    /// whose steps never reach a wall wastes a few trials only. A flight in uniform gravity is the case in point: its motion
-    /// is nearly polynomial, so a lower order reaches the floor at a
-    /// fraction of the cost, and the cost of a series grows as the square
-    /// of its order.
+    /// trials stop) to the lowest order whose own step, read off the same
+    /// coefficients ([`Plan::step_at`]), reaches as far as the full one
+    /// went: to the wall it meets at τ, else to the end of its step. So
+    /// each run learns, in a trial or two, the lowest order its flights
+    /// need so far, and a motion whose steps the radius of convergence
+    /// bounds (where no lower order steps as far) wastes one trial. A
+    /// flight in uniform gravity is the case in point: its motion is nearly
+    /// polynomial, so a lower order reaches the floor at a fraction of the
+    /// cost, and the cost of a series grows as the square of its order.
     ///
     /// [`Taylor::low_order`]: super::Taylor::low_order
     pub(super) fn series_step(
@@ -70,12 +71,10 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         let h = self.series(method, method.order, left)?;
         let found = self.first_collision(h)?;
         if tried {
-            self.low_order = match found {
-                Some((_, tau)) => (self.low_order + 1..method.order)
-                    .find(|&p| method.step_at(&self.series, p) >= tau)
-                    .unwrap_or(method.order),
-                None => self.low_order + 2,
-            };
+            let reach = found.map_or(h, |(_, tau)| tau);
+            self.low_order = (self.low_order + 1..method.order)
+                .find(|&p| method.step_at(&self.series, p) >= reach)
+                .unwrap_or(method.order);
         }
         self.low_order_first = found.is_some();
         self.take(h, t_end, found)

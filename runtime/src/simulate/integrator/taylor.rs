@@ -6,7 +6,16 @@
 //! polynomial is its dense output.
 
 use crate::libm;
-use crate::taylor::{MAX_ORDER, Series};
+use crate::simulate::thresholds::SERIES_SAMPLES;
+use crate::taylor::{MAX_ORDER, Series, SeriesWork};
+
+/// A step's work besides the series of the motion and of the walls, the
+/// state on the step and the root search's samples, in multiply-adds, for
+/// [`Taylor::order_for`]'s cost model: the step size, the report of the
+/// energy and residuals, the bookkeeping. Fitted to the per-step times of
+/// `ball_wall_euler` at fixed orders 20 to 31 (docs/performance.md), where
+/// it came out at 980.
+const STEP_OVERHEAD: f64 = 1000.0;
 
 /// Taylor's method of the order the tolerance asks for.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -46,15 +55,62 @@ impl Taylor {
                 .is_none_or(|p| (2..=MAX_ORDER).contains(&p))
     }
 
-    /// The order: the fixed order if one is set, else ⌈−½ ln ε + 1⌉ (Jorba
-    /// & Zou, eq. 3.8), at least 2 and at most [`MAX_ORDER`] (the step size
-    /// reads the coefficients of order p − 1 and p).
+    /// The order the tolerance asks for: the fixed order if one is set, else
+    /// ⌈−½ ln ε + 1⌉ (Jorba & Zou, eq. 3.8), at least 2 and at most
+    /// [`MAX_ORDER`] (the step size reads the coefficients of order p − 1
+    /// and p). The simulator steps at [`Taylor::order_for`] the model, this
+    /// or higher.
     pub fn order(&self) -> usize {
         let p = match self.fixed_order {
             Some(p) => p,
             None => libm::ceil(-0.5 * libm::log(self.tolerance) + 1.0) as usize,
         };
         p.clamp(2, MAX_ORDER)
+    }
+
+    /// The order for a model whose series cost `work` per order, with `n`
+    /// coordinates and `walls` walls: the [`fixed_order`](Self::fixed_order)
+    /// if one is set, else [`Taylor::order`] where the work is unknown, else
+    /// the order from [`Taylor::order`] up to [`MAX_ORDER`] whose steps
+    /// cost least per unit of time. A step of order p costs the series of
+    /// the motion and of the walls to p, the state on it (2n(p + 1)
+    /// multiply-adds), the root search's samples of each wall's polynomial
+    /// and [`STEP_OVERHEAD`]; its length is the one [`Taylor::step`] takes
+    /// for a series whose coefficients fall like ρ⁻ᵏ: ρ·e⁻² at the
+    /// tolerance's order, ρ·ε^(1/p) (the last two terms below the
+    /// tolerance) above it, both with the safety factor. Jorba & Zou's
+    /// order balances the series' cost, which grows like p², against the
+    /// step; where the rest of the step weighs too, as in a small model, a
+    /// higher order pays.
+    pub fn order_for(&self, work: Option<SeriesWork>, n: usize, walls: usize) -> usize {
+        let (least, Some(work)) = (self.order(), work) else {
+            return self.order();
+        };
+        if self.fixed_order.is_some() {
+            return least;
+        }
+        let log_eps = libm::log(self.tolerance);
+        let per_time = |p: usize| {
+            let orders = (p + 1) as f64;
+            let step = work.motion.multiply_adds(p)
+                + work.walls.multiply_adds(p + 1)
+                + (2 * n) as f64 * orders
+                + (walls * SERIES_SAMPLES * 2) as f64 * orders
+                + STEP_OVERHEAD;
+            let mut log_h = log_eps / p as f64;
+            if p == least {
+                log_h = log_h.min(-2.0);
+            }
+            step / libm::exp(log_h - 0.7 / (p - 1) as f64)
+        };
+        let mut best = (per_time(least), least);
+        for p in least + 1..=MAX_ORDER {
+            let c = per_time(p);
+            if c < best.0 {
+                best = (c, p);
+            }
+        }
+        best.1
     }
 
     /// The lower order tried first where a step is likely to end at a wall
@@ -97,6 +153,7 @@ pub(crate) struct Plan {
 }
 
 impl Plan {
+    /// At the order the tolerance asks for ([`Taylor::order`]).
     pub fn new(method: Taylor) -> Self {
         Self {
             method,
@@ -107,6 +164,22 @@ impl Plan {
                 Some(_) => f64::INFINITY,
                 None => -2.0,
             },
+        }
+    }
+
+    /// At the order [`Taylor::order_for`] picks for a model; above the
+    /// tolerance's order, only the last two terms bound the step, as at a
+    /// fixed order. The lower order tried first stays the tolerance's.
+    pub fn fitted(self, work: Option<SeriesWork>, n: usize, walls: usize) -> Self {
+        let order = self.method.order_for(work, n, walls);
+        Self {
+            order,
+            log_asymptotic: if order > self.order {
+                f64::INFINITY
+            } else {
+                self.log_asymptotic
+            },
+            ..self
         }
     }
 
@@ -180,6 +253,58 @@ mod tests {
             };
             assert!(!bad.valid(), "order {p}");
         }
+    }
+
+    /// The order from the series' work: the tolerance's where the work is
+    /// unknown or the order fixed; higher the lighter the series, down to
+    /// the tolerance's + 1 for a heavy one (at the tolerance's order the
+    /// step is capped at ρ/e²); the cheapest per unit of time by the model
+    /// it states.
+    #[test]
+    fn order_from_the_series_work() {
+        use crate::taylor::Work;
+        let t = Taylor::default();
+        let work = |convolutions: usize, operations: usize| SeriesWork {
+            motion: Work {
+                operations,
+                convolutions,
+            },
+            walls: Work {
+                operations: 1,
+                convolutions: 0,
+            },
+        };
+        assert_eq!(t.order_for(None, 6, 1), 20);
+        let fixed = Taylor {
+            fixed_order: Some(22),
+            ..t
+        };
+        assert_eq!(fixed.order_for(Some(work(0, 0)), 6, 1), 22);
+        // ball_wall_euler's q̈ (11 convolutions in 34 operations), whose
+        // measured time per unit of motion is least at orders 24 to 28.
+        assert_eq!(t.order_for(Some(work(11, 34)), 5, 1), 26);
+        // A constant q̈: only the step's other work, which grows like p.
+        assert_eq!(t.order_for(Some(work(0, 0)), 6, 1), MAX_ORDER);
+        let mut last = MAX_ORDER;
+        for c in [0, 10, 100, 1000, 100_000] {
+            let p = t.order_for(Some(work(c, 2 * c)), 6, 1);
+            assert!(p <= last && p > t.order(), "{c} convolutions: order {p}");
+            last = p;
+        }
+        assert_eq!(last, 21);
+        // Lighter at a looser tolerance.
+        let loose = Taylor {
+            tolerance: 1e-10,
+            ..t
+        };
+        let p = loose.order_for(Some(work(11, 34)), 5, 1);
+        assert!(p > loose.order() && p < 26, "{p}");
+        // The plan above the tolerance's order steps by the truncation
+        // estimate alone, and keeps the tolerance's lower order.
+        let plan = Plan::new(t).fitted(Some(work(11, 34)), 5, 1);
+        assert_eq!((plan.order, plan.low_order), (26, 10));
+        assert_eq!(plan.log_asymptotic, f64::INFINITY);
+        assert_eq!(Plan::new(t).fitted(None, 5, 1), Plan::new(t));
     }
 
     /// For x(t) = 1/(1 − t) (x₀ = 1, all coefficients 1) the radius of
