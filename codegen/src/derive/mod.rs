@@ -183,8 +183,8 @@ impl Compiler {
     /// function but q̈. Taylor's method spends its time in q̈'s series,
     /// where a convolution costs a loop over the orders so far and any
     /// other series operation one step, so for q̈ the series' work at the
-    /// default order ([`Transform::cost`]) decides first, then the per-call
-    /// cost.
+    /// default tolerance's order, 20 ([`Transform::cost`]; the simulator
+    /// may step at a higher one), decides first, then the per-call cost.
     ///
     /// [`Transform::cost`]: crate::program::Transform::cost
     fn cheapest(&self, quantity: Quantity, candidates: Vec<Program>) -> Program {
