@@ -83,12 +83,10 @@ impl Taylor {
     /// step; where the rest of the step weighs too, as in a small model, a
     /// higher order pays.
     pub fn order_for(&self, work: Option<SeriesWork>, n: usize, walls: usize) -> usize {
-        let (least, Some(work)) = (self.order(), work) else {
-            return self.order();
-        };
-        if self.fixed_order.is_some() {
+        let least = self.order();
+        let Some(work) = work.filter(|_| self.fixed_order.is_none()) else {
             return least;
-        }
+        };
         let log_eps = libm::log(self.tolerance);
         let per_time = |p: usize| {
             let orders = (p + 1) as f64;
