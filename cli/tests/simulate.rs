@@ -300,7 +300,8 @@ fn a_model_file_simulates_without_writing_rust() {
 
 /// `--integrator taylor` runs a built-in model and a model file (through
 /// the interpreter's series) to the same collisions as the default method,
-/// at the tolerance's order and at a fixed one; a tolerance outside (0, 1),
+/// at the order picked from the model's series work and at a fixed one, and
+/// names the order in its summary; a tolerance outside (0, 1),
 /// an order beyond the series' capacity, or either with another method is
 /// refused.
 #[test]
@@ -327,6 +328,18 @@ fn taylor_integrator_from_the_command_line() {
             args.extend(method);
             let (ok, stdout, stderr) = dalembert(&args);
             assert!(ok, "{stdout}\n{stderr}");
+            // The summary names Taylor's order: picked from the model's
+            // series work (above the tolerance's 20 for these small
+            // models, built in or interpreted), or the one fixed.
+            let order = stdout.split("at order ").nth(1).map(|rest| {
+                let digits: String = rest.chars().take_while(char::is_ascii_digit).collect();
+                digits.parse::<usize>().unwrap()
+            });
+            match run {
+                "taylor" => assert!(order.is_some_and(|p| p > 20), "{stdout}"),
+                "taylor-28" => assert_eq!(order, Some(28), "{stdout}"),
+                _ => assert_eq!(order, None, "{stdout}"),
+            }
             let csv = std::fs::read_to_string(dir.join(format!("{name}.csv"))).unwrap();
             let hits = csv.lines().skip(1).filter(|l| !l.ends_with(',')).count();
             collisions.push(hits);
