@@ -66,6 +66,22 @@ impl Work {
     }
 }
 
+impl core::ops::Add for Work {
+    type Output = Work;
+    fn add(self, other: Work) -> Work {
+        Work {
+            operations: self.operations + other.operations,
+            convolutions: self.convolutions + other.convolutions,
+        }
+    }
+}
+
+impl core::iter::Sum for Work {
+    fn sum<I: Iterator<Item = Work>>(works: I) -> Work {
+        works.fold(Work::default(), |a, b| a + b)
+    }
+}
+
 /// What a model's series cost: the motion's (q̈'s program, whose orders 0
 /// to p − 1 give the series of order p) and every wall's f along it, summed
 /// ([`crate::Surfaces::series_work`]). Taylor's method picks its order from

@@ -152,13 +152,15 @@ fn header(d: &Ctx) -> String {
     }
     if let Some((motion, walls)) = taylor::transforms(d) {
         h.push_str("//\n// Taylor series, per order (series operations, of them convolutions):\n");
-        let (ops, loops) = taylor::counts(&motion);
+        let work = motion.work();
+        let (ops, loops) = (work.operations, work.convolutions);
         h.push_str(&format!(
             "//   {:<28} {ops} ops, {loops} convolutions\n",
             "motion_series"
         ));
         for (w, t) in d.walls.iter().zip(&walls) {
-            let (ops, loops) = taylor::counts(t);
+            let work = t.work();
+            let (ops, loops) = (work.operations, work.convolutions);
             let name = format!("{}_surface_series", w.name);
             h.push_str(&format!(
                 "//   {name:<28} {ops} ops, {loops} convolutions\n"

@@ -24,12 +24,6 @@ pub(super) fn transforms(d: &Ctx) -> Option<(Transform, Vec<Transform>)> {
     d.series()
 }
 
-/// Series operations per order, and how many of them are convolutions (a
-/// loop over the coefficients so far): for the header.
-pub(super) fn counts(t: &Transform) -> (usize, usize) {
-    (t.ops.len(), t.convolutions())
-}
-
 /// Histories summed side by side in one loop over j: x86-64 has 16
 /// vector registers, and each sum holds one while two operands are loaded.
 const HISTORIES_PER_LOOP: usize = 12;

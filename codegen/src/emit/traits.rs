@@ -9,7 +9,9 @@ use quote::{format_ident, quote};
 use super::functions::dims;
 use super::{Ctx, ident};
 use crate::ir::{Kind, camel};
+use crate::program::Transform;
 use crate::quantity::{Capability, Forward, Inputs, Shape, Spec, TABLE};
+use dalembert_runtime::taylor::Work;
 
 pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
     let ty = format_ident!("{}", d.model.type_name());
@@ -69,20 +71,15 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
     let (dynamics, surfaces) = (methods(Capability::Dynamics), methods(Capability::Surfaces));
     let (motion_series, surface_series) = match super::taylor::transforms(d) {
         Some((motion, walls)) => {
-            let work = |(operations, convolutions): (usize, usize)| {
+            let work = |w: Work| {
                 let (o, c) = (
-                    Literal::usize_unsuffixed(operations),
-                    Literal::usize_unsuffixed(convolutions),
+                    Literal::usize_unsuffixed(w.operations),
+                    Literal::usize_unsuffixed(w.convolutions),
                 );
                 quote! { ::dalembert_runtime::taylor::Work { operations: #o, convolutions: #c } }
             };
-            let motion_work = work(super::taylor::counts(&motion));
-            let walls_work = work(
-                walls
-                    .iter()
-                    .map(super::taylor::counts)
-                    .fold((0, 0), |(o, c), (wo, wc)| (o + wo, c + wc)),
-            );
+            let motion_work = work(motion.work());
+            let walls_work = work(walls.iter().map(Transform::work).sum());
             let arms = d.walls.iter().zip(&variants).map(|(w, v)| {
                 let f = format_ident!("{}_surface_series", w.name);
                 quote! { Wall::#v => self.#f(series, out) }

@@ -14,7 +14,7 @@ mod tape;
 
 use std::cell::RefCell;
 
-use dalembert_runtime::taylor::{Coefficients, MAX_ORDER, Series, SeriesWork, Work};
+use dalembert_runtime::taylor::{Coefficients, MAX_ORDER, Series, SeriesWork};
 use dalembert_runtime::{__private, Dynamics, Model, Rows, Surfaces, Values, Walls};
 
 use crate::derive::{Derivation, Function};
@@ -486,17 +486,9 @@ impl<const N: usize> Surfaces<N> for Interpreted<N> {
     }
     fn series_work(&self) -> Option<SeriesWork> {
         let sp = self.series.as_ref()?;
-        let work = |t: &Transform| Work {
-            operations: t.ops.len(),
-            convolutions: t.convolutions(),
-        };
-        let walls = sp.walls.iter().fold(Work::default(), |sum, (t, _)| Work {
-            operations: sum.operations + t.ops.len(),
-            convolutions: sum.convolutions + t.convolutions(),
-        });
         Some(SeriesWork {
-            motion: work(&sp.motion.0),
-            walls,
+            motion: sp.motion.0.work(),
+            walls: sp.walls.iter().map(|(t, _)| t.work()).sum(),
         })
     }
 }

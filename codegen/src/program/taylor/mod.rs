@@ -14,6 +14,8 @@
 
 use std::collections::HashMap;
 
+use dalembert_runtime::taylor::Work;
+
 use super::{Func, Instr, Program, Slot, constant};
 
 mod evaluate;
@@ -353,12 +355,21 @@ impl Op {
 }
 
 impl Transform {
-    /// The work of the series to `order`, in multiply-adds: each
-    /// convolution sums k − 1 products of its history at order k, and every
-    /// operation is finished once per order.
+    /// The work of the series to `order`, in multiply-adds
+    /// ([`Work::multiply_adds`]: each convolution sums k − 1 products of its
+    /// history at order k, and every operation is finished once per order;
+    /// a whole number).
     pub fn cost(&self, order: usize) -> usize {
-        let history = order.saturating_sub(1) * order.saturating_sub(2) / 2;
-        self.convolutions() * history + self.ops.len() * order
+        self.work().multiply_adds(order) as usize
+    }
+
+    /// Its series operations per order and, of them, its convolutions: for
+    /// the generated file's header and the model's `series_work`.
+    pub fn work(&self) -> Work {
+        Work {
+            operations: self.ops.len(),
+            convolutions: self.convolutions(),
+        }
     }
 
     /// How many of its series operations are convolutions (a loop over the
@@ -382,31 +393,15 @@ impl Transform {
             }
         };
         for op in &self.ops {
-            match op {
-                Op::Add { .. } | Op::Scale { .. } => {}
-                Op::Mul { a, b, .. } => {
-                    keep(a);
-                    keep(b);
-                }
-                Op::Square { a, .. } => keep(a),
-                Op::Div { dst, a, b } => {
-                    keep(dst);
-                    keep(a);
-                    keep(b);
-                }
-                Op::Recip { dst, a }
-                | Op::Sqrt { dst, a }
-                | Op::Power { dst, a, .. }
-                | Op::Exp { dst, a }
-                | Op::Log { dst, a } => {
-                    keep(dst);
-                    keep(a);
-                }
-                Op::SinCos { sin, cos, a } => {
-                    keep(sin);
-                    keep(cos);
-                    keep(a);
-                }
+            // Sums and scalings read their operands' current coefficients
+            // only; every other op reads its operands' lower ones, and all
+            // but the plain products their own too.
+            if matches!(op, Op::Add { .. } | Op::Scale { .. }) {
+                continue;
+            }
+            op.reads().iter().for_each(&mut keep);
+            if !matches!(op, Op::Mul { .. } | Op::Square { .. }) {
+                op.writes().iter().for_each(&mut keep);
             }
         }
         only

@@ -57,7 +57,7 @@ pub(super) fn fuse(ops: Vec<Op>, outputs: &mut [Term]) -> (Vec<Op>, usize) {
 
 impl Op {
     /// The series it reads (its own lower coefficients not counted).
-    fn reads(&self) -> Vec<Series> {
+    pub(super) fn reads(&self) -> Vec<Series> {
         match self {
             Op::Add { series, .. } => series.clone(),
             Op::Mul { a, b, .. } | Op::Div { a, b, .. } => vec![*a, *b],
