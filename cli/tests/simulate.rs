@@ -298,6 +298,26 @@ fn a_model_file_simulates_without_writing_rust() {
     assert!(!ok && stderr.contains("derived parameter"), "{stderr}");
 }
 
+/// The rows of a CSV at the times k·`every` (collisions left out), by k:
+/// their coordinates and velocities.
+type Grid = std::collections::BTreeMap<u64, Vec<f64>>;
+
+fn grid_rows(csv: &str, every: f64) -> Grid {
+    let mut grid = Grid::new();
+    for line in csv.lines().skip(1).filter(|l| l.ends_with(',')) {
+        let x: Vec<f64> = line
+            .split(',')
+            .take_while(|c| !c.is_empty())
+            .map(|c| c.parse().unwrap())
+            .collect();
+        let k = (x[0] / every).round();
+        if x[0] == k * every || x[0] == 3.0 {
+            grid.insert(k as u64, x[1..].to_vec());
+        }
+    }
+    grid
+}
+
 /// `--integrator taylor` runs a built-in model and a model file (through
 /// the interpreter's series) to the same collisions as the default method,
 /// at the order picked from the model's series work and at a fixed one, and
@@ -315,7 +335,7 @@ fn taylor_integrator_from_the_command_line() {
         } else {
             model.to_string()
         };
-        let mut collisions = Vec::new();
+        let (mut collisions, mut rows) = (Vec::new(), Vec::new());
         for (run, method) in [
             ("dormand-prince", &["dormand-prince"][..]),
             ("taylor", &["taylor"]),
@@ -343,10 +363,46 @@ fn taylor_integrator_from_the_command_line() {
             let csv = std::fs::read_to_string(dir.join(format!("{name}.csv"))).unwrap();
             let hits = csv.lines().skip(1).filter(|l| !l.ends_with(',')).count();
             collisions.push(hits);
+            // Taylor's rows come off each step's polynomial: its steps
+            // are not cut at the 2 000 rows (a few per flight, against
+            // one per row before; Dormand–Prince's still stop at rows).
+            let steps: u64 = stdout
+                .split(" steps")
+                .next()
+                .and_then(|head| head.split_whitespace().last())
+                .and_then(|n| n.parse().ok())
+                .unwrap();
+            assert_eq!(run != "dormand-prince", steps < 200, "{run}: {steps} steps");
+            rows.push(grid_rows(&csv, 3.0 / 2000.0));
         }
         assert!(collisions[0] > 0, "{name}: {collisions:?}");
         assert_eq!(collisions[0], collisions[1], "{name}");
         assert_eq!(collisions[0], collisions[2], "{name}");
+        // The same grid of rows from all three; the rows read off Taylor's
+        // polynomials agree with Dormand–Prince's step ends to its
+        // tolerance, and with each other's to rounding.
+        assert_eq!(rows[0].len(), 2001, "{name}: every grid time, 0 to 3");
+        for run in &rows[1..] {
+            assert_eq!(
+                run.keys().collect::<Vec<_>>(),
+                rows[0].keys().collect::<Vec<_>>()
+            );
+        }
+        let gap = |a: &Grid, b: &Grid| {
+            a.iter()
+                .flat_map(|(t, x)| x.iter().zip(&b[t]).map(|(x, y)| (x - y).abs()))
+                .fold(0.0, f64::max)
+        };
+        assert!(
+            gap(&rows[0], &rows[1]) < 1e-6,
+            "{name}: {}",
+            gap(&rows[0], &rows[1])
+        );
+        assert!(
+            gap(&rows[1], &rows[2]) < 1e-11,
+            "{name}: {}",
+            gap(&rows[1], &rows[2])
+        );
     }
     for (flag, value) in [("--tolerance", "2"), ("--order", "32"), ("--order", "1")] {
         let (ok, _, stderr) = dalembert(&[

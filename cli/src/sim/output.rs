@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use dalembert::runtime::prelude::*;
+use dalembert::runtime::simulate::residual;
 
 /// One output row.
 pub struct Row<const N: usize> {
@@ -14,6 +15,21 @@ pub struct Row<const N: usize> {
     pub energy: f64,
     pub residual: [f64; 2],
     pub event: Option<String>,
+}
+
+impl<const N: usize> Row<N> {
+    /// The row of the state (q, v) at t, its energy and residuals computed.
+    pub fn of<M: Surfaces<N>>(model: &M, t: f64, q: [f64; N], v: [f64; N]) -> Self {
+        let r = residual(model, &q, &v);
+        Row {
+            t,
+            q,
+            v,
+            energy: model.energy(&q, &v),
+            residual: [r.velocity, r.position],
+            event: None,
+        }
+    }
 }
 
 /// Rows kept in memory for the plot; the CSV has them all.

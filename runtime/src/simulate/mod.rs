@@ -52,6 +52,7 @@
 
 mod collision;
 mod control;
+mod dense_output;
 mod events;
 pub mod integrator;
 mod phase;
@@ -67,6 +68,7 @@ pub use types::{Collision, Residual, Settings, SimError, State, Stats, Step};
 use crate::Surfaces;
 use crate::dynamics::{accelerations, qdd};
 use crate::taylor::Series;
+use dense_output::LastStep;
 use integrator::{Engine, Method, RungeKutta};
 use phase::{Phase, norm};
 use thresholds::{ADMISSIBLE, MAX_WALLS, ON_WALL, TAYLOR_REACH};
@@ -96,6 +98,8 @@ pub struct Simulator<'m, M: Surfaces<N>, const N: usize> {
     /// Taylor's method: the series of the current step, a buffer reused
     /// by every step.
     series: Series<N>,
+    /// The last step's motion ([`Simulator::state_at`]).
+    last: Option<LastStep<N>>,
     stats: Stats,
 }
 
@@ -195,6 +199,7 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
             low_order_first: true,
             low_order,
             series: Series::at(&start.q, &start.v),
+            last: None,
             stats,
         })
     }
@@ -286,14 +291,23 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
                     .then(|| at_end(a.wall, t1 + ahead))
             }),
         };
+        let mut last = LastStep {
+            t0,
+            t0_low: 0.0,
+            stop: t1,
+            interpolant: Some((h, trial.dense)),
+        };
         match found {
             Some(located) => {
                 let collision = self.collide(method, &y0, t0, located)?;
                 self.stats.steps += 1;
                 self.stats.collisions += 1;
+                last.stop = collision.t;
+                self.last = Some(last);
                 Ok(self.report(t0, Some(collision)))
             }
             None => {
+                self.last = Some(last);
                 self.state = State {
                     t: t1,
                     q: trial.y1.q,

@@ -5,6 +5,7 @@
 //! Newton's method kept inside the bracket). The state at the collision is
 //! the step's polynomial there, so a collision costs no further steps.
 
+use super::dense_output::LastStep;
 use super::integrator::Plan;
 use super::phase::Phase;
 use super::thresholds::{SERIES_ROOT_ITERATIONS, SERIES_SAMPLES};
@@ -168,10 +169,18 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         let t0 = self.state.t;
         let left = (t_end - t0) - self.t_low;
         self.stats.steps += 1;
+        let mut last = LastStep {
+            t0,
+            t0_low: self.t_low,
+            stop: t0,
+            interpolant: None,
+        };
         match found {
             Some((k, tau)) => {
                 let (q, v) = finite(self.series.state(tau), t0)?;
                 let tc = self.advance_time(tau);
+                last.stop = tc;
+                self.last = Some(last);
                 let collision = self.land(k, tc, &Phase { q, v }, t0, h)?;
                 self.stats.collisions += 1;
                 Ok(self.report(t0, Some(collision)))
@@ -184,6 +193,8 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
                 } else {
                     self.advance_time(h)
                 };
+                last.stop = t1;
+                self.last = Some(last);
                 self.state = State { t: t1, q, v };
                 self.leave_walls();
                 self.project()?;

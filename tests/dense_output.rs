@@ -1,0 +1,80 @@
+//! `Simulator::state_at`: the motion inside the last step, against the
+//! exact §3.2.1 flights, for Taylor's method (the step's polynomial) and
+//! Dormand–Prince (Shampine's interpolant; exact for the flights' parabolas
+//! up to the steps' own error).
+
+use dalembert::models::*;
+use dalembert::runtime::simulate::{DormandPrince, Integrator, Settings, Simulator, State, Taylor};
+
+#[path = "common/bounce.rs"]
+mod bounce;
+
+/// §3.2.1's exact motion from the bounce at t = 0 at time t of flight n
+/// (from the n-th bounce to the next; each bounce reverses the velocity;
+/// φ = 0 and θ = π/2 throughout).
+fn exact(ball: &BallBounce, t: f64, n: f64) -> ([f64; 6], [f64; 6]) {
+    let p = ball.params();
+    let flight = 2.0 * bounce::U / p.g;
+    let s = t - n * flight;
+    let sign = if n as i64 % 2 == 0 { 1.0 } else { -1.0 };
+    let (vx, wz) = (sign * bounce::V, sign * p.r * p.m * bounce::V / p.J);
+    let x = if sign > 0.0 { s } else { flight - s } * bounce::V;
+    let psi = if sign > 0.0 { s } else { flight - s } * wz.abs();
+    let z = p.r + bounce::U * s - 0.5 * p.g * s * s;
+    let q = [x, 0.0, z, 0.0, core::f64::consts::FRAC_PI_2, psi];
+    let v = [vx, 0.0, bounce::U - p.g * s, 0.0, 0.0, wz];
+    (q, v)
+}
+
+/// Runs 20 bounces with `integrator`, reading the state at 7 times inside
+/// every step; the largest gap from the exact motion. Checks that no state
+/// is given outside the last step.
+fn inside_the_steps(integrator: Integrator) -> f64 {
+    let ball = BallBounce::default();
+    let (q, v) = bounce::after_bounce(&ball);
+    let settings = Settings {
+        integrator,
+        ..Settings::default()
+    };
+    let mut sim = Simulator::new(&ball, State { t: 0.0, q, v }, settings).unwrap();
+    assert!(sim.state_at(0.0).is_none(), "no step yet");
+    let t_end = 20.5 * 2.0 * bounce::U / ball.params().g;
+    let mut gap = 0.0f64;
+    while sim.state().t < t_end {
+        let step = sim.step(t_end).unwrap();
+        let stop = step.collision.as_ref().map_or(step.state.t, |c| c.t);
+        let flight = ((step.t0 + stop) / 2.0 / (2.0 * bounce::U / ball.params().g)).floor();
+        for i in 0..=6 {
+            let t = step.t0 + (stop - step.t0) * i as f64 / 6.0;
+            let s = sim.state_at(t).expect("inside the step");
+            assert_eq!(s.t, t);
+            let (q, v) = exact(&ball, t, flight);
+            for (a, b) in s.q.iter().chain(&s.v).zip(q.iter().chain(&v)) {
+                gap = gap.max((a - b).abs());
+            }
+        }
+        // Just before the collision: its state before the map.
+        if let Some(c) = &step.collision {
+            let s = sim.state_at(c.t).unwrap();
+            for (a, b) in s.q.iter().chain(&s.v).zip(c.q.iter().chain(&c.v_minus)) {
+                assert!((a - b).abs() < 1e-13, "{a} against {b} at the collision");
+            }
+        }
+        let span = stop - step.t0;
+        assert!(sim.state_at(step.t0 - 0.01 * span).is_none());
+        assert!(sim.state_at(stop + 0.01 * span).is_none());
+    }
+    gap
+}
+
+#[test]
+fn taylor_steps_polynomial_is_the_motion_to_rounding() {
+    let gap = inside_the_steps(Integrator::Taylor(Taylor::default()));
+    assert!(gap < 1e-13, "{gap:e}");
+}
+
+#[test]
+fn dormand_prince_interpolant_is_the_motion_to_its_tolerance() {
+    let gap = inside_the_steps(Integrator::DormandPrince(DormandPrince::default()));
+    assert!(gap < 1e-11, "{gap:e}");
+}
