@@ -38,10 +38,17 @@ pub(super) fn functions(d: &Ctx) -> TokenStream {
     let motion_ops = ops(d, &motion);
     let feedback = (0..d.model.velocities.len()).map(|i| {
         let i_lit = Literal::usize_unsuffixed(i);
-        let out = output(d, &motion, i);
+        // A zero acceleration (a free coordinate) is zero at every order.
+        let out = match motion.outputs[i] {
+            Term::Number(Slot::Const(c)) if motion.numbers.consts[c] == 0.0 => quote! { 0.0 },
+            _ => {
+                let out = output(d, &motion, i);
+                quote! { #out * ik }
+            }
+        };
         quote! {
             s.q[#i_lit][k + 1] = s.v[#i_lit][k] * ik;
-            s.v[#i_lit][k + 1] = #out * ik;
+            s.v[#i_lit][k + 1] = #out;
         }
     });
     let motion_fn = quote! {
@@ -168,6 +175,10 @@ fn output(d: &Ctx, t: &Transform, o: usize) -> TokenStream {
             let s = series(s);
             quote! { #s[k] }
         }
+        Term::Negated(s) => {
+            let s = series(s);
+            quote! { (-#s[k]) }
+        }
     }
 }
 
@@ -219,9 +230,15 @@ fn linear(d: &Ctx, p: &Program, op: &Op, at: At) -> Option<TokenStream> {
             numbers,
         } => {
             let dst = series(*dst);
-            let terms = terms.iter().map(|s| {
-                let s = series(*s);
-                quote! { #s[k] }
+            // In order, each with its sign: `a[k] - b[k] + c[k]`.
+            let terms = terms.iter().enumerate().map(|(i, t)| {
+                let s = series(t.series);
+                match (i, t.minus) {
+                    (0, false) => quote! { #s[k] },
+                    (0, true) => quote! { -#s[k] },
+                    (_, false) => quote! { + #s[k] },
+                    (_, true) => quote! { - #s[k] },
+                }
             });
             let constant = (at != At::Beyond && !numbers.is_empty()).then(|| {
                 let ns = numbers.iter().map(|s| number(d, p, *s));
@@ -232,7 +249,7 @@ fn linear(d: &Ctx, p: &Program, op: &Op, at: At) -> Option<TokenStream> {
                     add
                 }
             });
-            Some(quote! { #dst[k] = #(#terms)+*; #constant })
+            Some(quote! { #dst[k] = #(#terms)*; #constant })
         }
         Op::Scale { dst, a, by } => {
             let (dst, a) = (series(*dst), series(*a));

@@ -83,7 +83,12 @@ impl Transform {
                 Op::Add {
                     series, numbers, ..
                 } => {
-                    let mut x: f64 = series.iter().map(|s| get(*s)[k]).sum();
+                    // As emitted code sums: in order, from the first term.
+                    let mut x = -0.0;
+                    for t in series {
+                        let c = get(t.series)[k];
+                        x = if t.minus { x - c } else { x + c };
+                    }
                     if k == 0 {
                         x += numbers.iter().map(slot_value).sum::<f64>();
                     }
@@ -111,9 +116,8 @@ impl Transform {
         match self.outputs[o] {
             Term::Number(s) if k == 0 => numbers[self.number_index(s)],
             Term::Number(_) => 0.0,
-            Term::Series(Series::Q(i)) => e.q[i][k],
-            Term::Series(Series::V(i)) => e.v[i][k],
-            Term::Series(Series::Temp(i)) => e.temps[i][k],
+            Term::Series(s) => coefficient(e, s, k),
+            Term::Negated(s) => -coefficient(e, s, k),
         }
     }
 
@@ -170,5 +174,14 @@ impl Transform {
             *o = self.output(e, numbers, 0, k);
         }
         out
+    }
+}
+
+/// Coefficient k of series `s` in `e`.
+fn coefficient(e: &Evaluation, s: Series, k: usize) -> f64 {
+    match s {
+        Series::Q(i) => e.q[i][k],
+        Series::V(i) => e.v[i][k],
+        Series::Temp(i) => e.temps[i][k],
     }
 }

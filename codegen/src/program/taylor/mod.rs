@@ -19,6 +19,7 @@ use dalembert_runtime::taylor::Work;
 use super::{Func, Instr, Program, Slot, constant};
 
 mod evaluate;
+mod negations;
 mod quotients;
 pub use evaluate::Evaluation;
 
@@ -41,16 +42,27 @@ pub enum Term {
     Number(Slot),
     /// A series.
     Series(Series),
+    /// A series negated: only as an output, where `negations.rs` moved
+    /// the sign of a negation.
+    Negated(Series),
+}
+
+/// A term of a sum: a series added, or subtracted.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Summand {
+    pub series: Series,
+    pub minus: bool,
 }
 
 /// One coefficient of one intermediate series from coefficients of others
 /// (`dst` is always a [`Series::Temp`]).
 #[derive(Debug, Clone, PartialEq)]
 pub enum Op {
-    /// Σ series + Σ numbers (the numbers count at order 0 only).
+    /// Σ ±series, in order, + Σ numbers (the numbers count at order 0
+    /// only).
     Add {
         dst: Series,
-        series: Vec<Series>,
+        series: Vec<Summand>,
         numbers: Vec<Slot>,
     },
     /// a times a number.
@@ -143,7 +155,10 @@ impl<'a> Builder<'a> {
                     .unwrap_or_else(|| Term::Number(constant(&mut self.numbers.consts, 0.0)))
             })
             .collect();
-        let (ops, temps) = quotients::fuse(self.ops, &mut outputs);
+        let ops = quotients::fuse(self.ops, &outputs);
+        let minus_one = constant(&mut self.numbers.consts, -1.0);
+        let ops = negations::fold(ops, &mut outputs, &self.numbers.consts, minus_one);
+        let (ops, temps) = renumber(ops, &mut outputs);
         Transform {
             numbers: self.numbers,
             temps,
@@ -189,7 +204,7 @@ impl<'a> Builder<'a> {
             .iter()
             .map(|t| match t {
                 Term::Number(s) => Some(*s),
-                Term::Series(_) => None,
+                Term::Series(_) | Term::Negated(_) => None,
             })
             .collect();
         if let Some(slots) = numbers {
@@ -201,7 +216,7 @@ impl<'a> Builder<'a> {
         }
         let series_of = |t: &Term| match t {
             Term::Series(s) => *s,
-            Term::Number(_) => unreachable!("checked to be a series"),
+            Term::Number(_) | Term::Negated(_) => unreachable!("checked to be a series"),
         };
         match ins {
             Instr::Assign(_, _) => terms[0],
@@ -285,8 +300,12 @@ impl<'a> Builder<'a> {
         let mut numbers = Vec::new();
         for t in terms {
             match t {
-                Term::Series(s) => series.push(*s),
+                Term::Series(s) => series.push(Summand {
+                    series: *s,
+                    minus: false,
+                }),
                 Term::Number(n) => numbers.push(*n),
+                Term::Negated(_) => unreachable!("only outputs are negated"),
             }
         }
         Term::Series(self.op(|dst| Op::Add {
@@ -309,8 +328,29 @@ impl<'a> Builder<'a> {
             (Term::Series(x), Term::Series(y)) => {
                 Term::Series(self.op(|dst| Op::Mul { dst, a: x, b: y }))
             }
+            (Term::Negated(_), _) | (_, Term::Negated(_)) => {
+                unreachable!("only outputs are negated")
+            }
         }
     }
+}
+
+/// The temporaries numbered again, without gaps, in the order they are
+/// written; returns the ops and how many temporaries they use.
+fn renumber(mut ops: Vec<Op>, outputs: &mut [Term]) -> (Vec<Op>, usize) {
+    let mut renumbered = HashMap::new();
+    for s in ops.iter().flat_map(Op::writes) {
+        let next = renumbered.len();
+        renumbered.entry(s).or_insert(Series::Temp(next));
+    }
+    let rename = |s: Series| renumbered.get(&s).copied().unwrap_or(s);
+    for t in outputs.iter_mut() {
+        if let Term::Series(s) | Term::Negated(s) = t {
+            *s = rename(*s);
+        }
+    }
+    ops.iter_mut().for_each(|op| op.rename(&rename));
+    (ops, renumbered.len())
 }
 
 /// `ins` writing `dst` from `sources` (its own, renamed).

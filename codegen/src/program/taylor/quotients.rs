@@ -8,10 +8,8 @@ use super::{Op, Series, Term};
 
 /// Every product with a reciprocal, a·(1/b), made a quotient a/b: one
 /// convolution where the reciprocal and the product take two. A
-/// reciprocal no longer read is dropped, and the temporaries are numbered
-/// again in the order they are written. Returns the ops and how many
-/// temporaries they use.
-pub(super) fn fuse(ops: Vec<Op>, outputs: &mut [Term]) -> (Vec<Op>, usize) {
+/// reciprocal no longer read is dropped.
+pub(super) fn fuse(ops: Vec<Op>, outputs: &[Term]) -> Vec<Op> {
     let recips: HashMap<Series, Series> = ops
         .iter()
         .filter_map(|op| match op {
@@ -32,34 +30,20 @@ pub(super) fn fuse(ops: Vec<Op>, outputs: &mut [Term]) -> (Vec<Op>, usize) {
         .collect();
     let mut read: HashSet<Series> = fused.iter().flat_map(Op::reads).collect();
     read.extend(outputs.iter().filter_map(|t| match t {
-        Term::Series(s) => Some(*s),
+        Term::Series(s) | Term::Negated(s) => Some(*s),
         Term::Number(_) => None,
     }));
-    let kept: Vec<Op> = fused
+    fused
         .into_iter()
         .filter(|op| !matches!(op, Op::Recip { dst, .. } if !read.contains(dst)))
-        .collect();
-    let mut renumbered = HashMap::new();
-    for s in kept.iter().flat_map(Op::writes) {
-        let next = renumbered.len();
-        renumbered.entry(s).or_insert(Series::Temp(next));
-    }
-    let rename = |s: Series| renumbered.get(&s).copied().unwrap_or(s);
-    for t in outputs.iter_mut() {
-        if let Term::Series(s) = t {
-            *s = rename(*s);
-        }
-    }
-    let mut ops = kept;
-    ops.iter_mut().for_each(|op| op.rename(&rename));
-    (ops, renumbered.len())
+        .collect()
 }
 
 impl Op {
     /// The series it reads (its own lower coefficients not counted).
     pub(super) fn reads(&self) -> Vec<Series> {
         match self {
-            Op::Add { series, .. } => series.clone(),
+            Op::Add { series, .. } => series.iter().map(|t| t.series).collect(),
             Op::Mul { a, b, .. } | Op::Div { a, b, .. } => vec![*a, *b],
             Op::Scale { a, .. }
             | Op::Square { a, .. }
@@ -73,11 +57,11 @@ impl Op {
     }
 
     /// Replaces each series it reads or writes by the one `rename` gives.
-    fn rename(&mut self, r: &impl Fn(Series) -> Series) {
+    pub(super) fn rename(&mut self, r: &impl Fn(Series) -> Series) {
         match self {
             Op::Add { dst, series, .. } => {
                 *dst = r(*dst);
-                series.iter_mut().for_each(|s| *s = r(*s));
+                series.iter_mut().for_each(|t| t.series = r(t.series));
             }
             Op::Mul { dst, a, b } | Op::Div { dst, a, b } => {
                 (*dst, *a, *b) = (r(*dst), r(*a), r(*b));

@@ -21,7 +21,7 @@
 //   holonomic                    0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   forcing                      13 add, 34 mul, 0 div, 4 fn (51 in all)
 //   constraint_drift             4 add, 14 mul, 0 div, 4 fn (22 in all)
-//   accelerations                9 add, 23 mul, 1 div, 4 fn (37 in all)
+//   accelerations                5 add, 18 mul, 1 div, 4 fn (28 in all)
 //   initial_state                0 add, 1 mul, 0 div, 0 fn (1 in all)
 //   wall_surface                 1 add, 0 mul, 0 div, 0 fn (1 in all)
 //   wall_normal                  0 add, 0 mul, 0 div, 0 fn (0 in all)
@@ -32,7 +32,7 @@
 //   wall_collide                 25 add, 55 mul, 1 div, 4 fn (85 in all)
 //
 // Parameter-only work, done once when the parameters are set (41 values kept):
-//   all functions                6 add, 47 mul, 5 div, 0 fn (58 in all)
+//   all functions                6 add, 47 mul, 6 div, 0 fn (59 in all)
 //
 // Solves, the cheapest form per call (cost: add + mul + 4 div + 20 fn):
 //   wall_collide                 the exact closed form [closed form 164, elimination 220]
@@ -178,16 +178,18 @@ impl BallWallEuler {
             let i4: f32 = params.a;
             let t0: f32 = i1 * i1;
             let t0: f32 = i0 * t0;
-            pre[7] = t0;
             let t1: f32 = i2 + t0;
-            let t1: f32 = 1.0 / (t1);
-            let t1: f32 = -(t1);
-            pre[8] = t1;
-            let o0: f32 = i4 * t0 * t1;
-            pre[9] = o0;
-            let o2: f32 = i0 * i4;
-            pre[10] = o2;
-            pre[11] = i0 * i1;
+            pre[7] = t1;
+            let t3: f32 = 1.0 / (t1);
+            pre[8] = t3;
+            let t2: f32 = -(i4);
+            let t0: f32 = t0 * t3 * t2;
+            pre[11] = t0;
+            let t2: f32 = i0 * i1 * t2;
+            pre[9] = t2;
+            let t4: f32 = 1.0 / (t1);
+            pre[10] = t4;
+            let o0: f32 = t0;
         }
         {
             let i1: f32 = params.r;
@@ -494,57 +496,43 @@ impl BallWallEuler {
     #[inline]
     #[allow(unused_variables, clippy::approx_constant)]
     pub fn accelerations(&self, q: &[f32; 5], v: &[f32; 5]) -> [f32; 5] {
-        let i1: f32 = self.params.r;
-        let i2: f32 = self.params.J;
-        let i4: f32 = self.params.a;
         let i7: f32 = q[2];
         let i8: f32 = q[3];
         let i12: f32 = v[2];
         let i13: f32 = v[3];
         let i14: f32 = v[4];
-        let t0: f32 = self.pre[7];
-        let t1: f32 = self.pre[8];
-        let o0: f32 = self.pre[9];
+        let t1: f32 = self.pre[7];
+        let t3: f32 = self.pre[8];
+        let t2: f32 = self.pre[9];
+        let t4: f32 = self.pre[10];
         let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
-        let o3: f32 = sc0_sin;
-        let t4: f32 = t0 * o3;
-        let t5: f32 = i2 * o3;
-        let t4: f32 = t4 + t5;
-        let t5: f32 = 1.0 / (t4);
+        let t5: f32 = sc0_cos;
+        let t6: f32 = -(t5);
+        let o3: f32 = i12 * t6;
+        let o3: f32 = i14 + o3;
+        let t8: f32 = i13 * t1;
+        let o3: f32 = o3 * t8;
         let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
-        let t4: f32 = sc1_cos;
-        let o4: f32 = sc0_cos;
-        let o4: f32 = -(o4);
-        let o2: f32 = self.pre[10];
-        let t4: f32 = i1 * t4;
-        let t4: f32 = o2 * t4;
-        let o2: f32 = o4 * t4;
-        let t8: f32 = i12 * o4;
-        let t8: f32 = i14 + t8;
-        let t9: f32 = t0 * t8;
-        let t8: f32 = i2 * t8;
-        let t8: f32 = t9 + t8;
-        let t9: f32 = i13 * t8;
-        let t8: f32 = o2 + t9;
-        let o2: f32 = t5 * t8;
-        let t9: f32 = i14 * o3;
-        let t8: f32 = i12 * t9;
-        let o3: f32 = i1 * t8;
-        let t9: f32 = sc1_sin;
-        let t9: f32 = i4 * t9;
-        let o3: f32 = o3 + t9;
-        let t9: f32 = self.pre[11] * o3;
-        let o3: f32 = i2 * t8;
-        let t8: f32 = t9 + o3;
-        let o3: f32 = t1 * t8;
-        let t9: f32 = i14 * o4;
-        let t1: f32 = i12 + t9;
-        let t8: f32 = t0 * t1;
-        let o4: f32 = i2 * t1;
-        let t9: f32 = t8 + o4;
-        let t0: f32 = i13 * t9;
-        let t1: f32 = t4 + t0;
-        let o4: f32 = t5 * t1;
+        let o4: f32 = sc1_cos;
+        let o4: f32 = t2 * o4;
+        let t5: f32 = t5 * o4;
+        let t5: f32 = o3 + t5;
+        let o3: f32 = sc0_sin;
+        let o2: f32 = 1.0 / (o3);
+        let t4: f32 = t4 * o2;
+        let o2: f32 = t5 * t4;
+        let t5: f32 = -(i12 * i14 * t1 * o3);
+        let o3: f32 = sc1_sin;
+        let o3: f32 = t2 * o3;
+        let t5: f32 = t5 + o3;
+        let o3: f32 = t3 * t5;
+        let t5: f32 = i14 * t6;
+        let t6: f32 = i12 + t5;
+        let t5: f32 = t8 * t6;
+        let t6: f32 = -(o4);
+        let t8: f32 = t5 + t6;
+        let o4: f32 = t4 * t8;
+        let o0: f32 = self.pre[11];
         let o1: f32 = 0f32;
         [o0, o1, o2, o3, o4]
     }
