@@ -4,7 +4,9 @@
 //! up to the steps' own error).
 
 use dalembert::models::*;
-use dalembert::runtime::simulate::{DormandPrince, Integrator, Settings, Simulator, State, Taylor};
+use dalembert::runtime::simulate::{
+    DormandPrince, Integrator, Settings, SimError, Simulator, State, Taylor,
+};
 
 #[path = "common/bounce.rs"]
 mod bounce;
@@ -77,4 +79,29 @@ fn taylor_steps_polynomial_is_the_motion_to_rounding() {
 fn dormand_prince_interpolant_is_the_motion_to_its_tolerance() {
     let gap = inside_the_steps(Integrator::DormandPrince(DormandPrince::default()));
     assert!(gap < 1e-11, "{gap:e}");
+}
+
+/// A step that fails (here at a grazing contact found on the step's
+/// polynomial, as `tests/simulation_errors.rs` sets it up) leaves no motion
+/// to read: the simulator stays where it was, and so does `state_at`.
+#[test]
+fn a_failed_step_leaves_no_motion() {
+    let ball = BallBounce::default();
+    let r = ball.params().r;
+    let q = [0.0, 0.0, r + 1e-15, 0.0, core::f64::consts::FRAC_PI_2, 0.0];
+    let start = State {
+        t: 0.0,
+        q,
+        v: [100.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    };
+    let settings = Settings {
+        integrator: Integrator::Taylor(Taylor::default()),
+        ..Settings::default()
+    };
+    let mut sim = Simulator::new(&ball, start, settings).unwrap();
+    let Err(SimError::Grazing { t, .. }) = sim.step(1.0) else {
+        panic!("expected a grazing contact");
+    };
+    assert_eq!(sim.state().t, 0.0);
+    assert!(sim.state_at(0.5 * t).is_none());
 }

@@ -179,9 +179,9 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             Some((k, tau)) => {
                 let (q, v) = finite(self.series.state(tau), t0)?;
                 let tc = self.advance_time(tau);
+                let collision = self.land(k, tc, &Phase { q, v }, t0, h)?;
                 last.stop = tc;
                 self.last = Some(last);
-                let collision = self.land(k, tc, &Phase { q, v }, t0, h)?;
                 self.stats.collisions += 1;
                 Ok(self.report(t0, Some(collision)))
             }
