@@ -39,12 +39,11 @@ pub(super) fn functions(d: &Ctx) -> TokenStream {
     let feedback = (0..d.model.velocities.len()).map(|i| {
         let i_lit = Literal::usize_unsuffixed(i);
         // A zero acceleration (a free coordinate) is zero at every order.
-        let out = match motion.outputs[i] {
-            Term::Number(Slot::Const(c)) if motion.numbers.consts[c] == 0.0 => quote! { 0.0 },
-            _ => {
-                let out = output(d, &motion, i);
-                quote! { #out * ik }
-            }
+        let out = if zero_output(&motion, i) {
+            quote! { 0.0 }
+        } else {
+            let out = output(d, &motion, i);
+            quote! { #out * ik }
         };
         quote! {
             s.q[#i_lit][k + 1] = s.v[#i_lit][k] * ik;
@@ -163,10 +162,15 @@ fn number(d: &Ctx, p: &Program, s: Slot) -> TokenStream {
     body::slot(d, p, s)
 }
 
+/// Whether output `o` is the constant 0.
+fn zero_output(t: &Transform, o: usize) -> bool {
+    matches!(t.outputs[o], Term::Number(Slot::Const(i)) if t.numbers.consts[i] == 0.0)
+}
+
 /// Coefficient k of output `o`.
 fn output(d: &Ctx, t: &Transform, o: usize) -> TokenStream {
     match t.outputs[o] {
-        Term::Number(Slot::Const(i)) if t.numbers.consts[i] == 0.0 => quote! { 0.0 },
+        _ if zero_output(t, o) => quote! { 0.0 },
         Term::Number(s) => {
             let x = number(d, &t.numbers, s);
             quote! { (if k == 0 { #x } else { 0.0 }) }

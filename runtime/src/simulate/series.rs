@@ -169,10 +169,11 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         let t0 = self.state.t;
         let left = (t_end - t0) - self.t_low;
         self.stats.steps += 1;
-        let mut last = LastStep {
+        let t0_low = self.t_low;
+        let last = |stop| LastStep {
             t0,
-            t0_low: self.t_low,
-            stop: t0,
+            t0_low,
+            stop,
             interpolant: None,
         };
         match found {
@@ -180,8 +181,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
                 let (q, v) = finite(self.series.state(tau), t0)?;
                 let tc = self.advance_time(tau);
                 let collision = self.land(k, tc, &Phase { q, v }, t0, h)?;
-                last.stop = tc;
-                self.last = Some(last);
+                self.last = Some(last(tc));
                 self.stats.collisions += 1;
                 Ok(self.report(t0, Some(collision)))
             }
@@ -193,8 +193,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
                 } else {
                     self.advance_time(h)
                 };
-                last.stop = t1;
-                self.last = Some(last);
+                self.last = Some(last(t1));
                 self.state = State { t: t1, q, v };
                 self.leave_walls();
                 self.project()?;

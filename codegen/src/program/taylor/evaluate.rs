@@ -23,6 +23,17 @@ pub struct Evaluation {
     pub temps: Vec<Coefficients>,
 }
 
+impl Evaluation {
+    /// The coefficients of series `s`.
+    fn series(&self, s: Series) -> &Coefficients {
+        match s {
+            Series::Q(i) => &self.q[i],
+            Series::V(i) => &self.v[i],
+            Series::Temp(i) => &self.temps[i],
+        }
+    }
+}
+
 impl Transform {
     /// The time-constant values at the parameters `params`: a vector that
     /// [`Term::Number`] slots index by [`Transform::number_index`]. `eval`
@@ -62,13 +73,7 @@ impl Transform {
     pub fn order(&self, e: &mut Evaluation, numbers: &[f64], k: usize) {
         for op in &self.ops {
             // Operands by reference: a copy would move 256 bytes per operand.
-            let get = |s: Series| -> &Coefficients {
-                match s {
-                    Series::Q(i) => &e.q[i],
-                    Series::V(i) => &e.v[i],
-                    Series::Temp(i) => &e.temps[i],
-                }
-            };
+            let get = |s: Series| e.series(s);
             let slot_value = |s: &Slot| numbers[self.number_index(*s)];
             let value = match op {
                 Op::SinCos { sin, cos, a } => {
@@ -116,8 +121,8 @@ impl Transform {
         match self.outputs[o] {
             Term::Number(s) if k == 0 => numbers[self.number_index(s)],
             Term::Number(_) => 0.0,
-            Term::Series(s) => coefficient(e, s, k),
-            Term::Negated(s) => -coefficient(e, s, k),
+            Term::Series(s) => e.series(s)[k],
+            Term::Negated(s) => -e.series(s)[k],
         }
     }
 
@@ -174,14 +179,5 @@ impl Transform {
             *o = self.output(e, numbers, 0, k);
         }
         out
-    }
-}
-
-/// Coefficient k of series `s` in `e`.
-fn coefficient(e: &Evaluation, s: Series, k: usize) -> f64 {
-    match s {
-        Series::Q(i) => e.q[i][k],
-        Series::V(i) => e.v[i][k],
-        Series::Temp(i) => e.temps[i][k],
     }
 }
