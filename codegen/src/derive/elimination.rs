@@ -8,7 +8,7 @@ use std::ops::Range;
 use symbolica::prelude::*;
 
 use super::mechanics::{Exact, Raw};
-use super::output::{Choice, Form, Function};
+use super::output::{Choice, Form, Function, MotionSystem};
 use super::symbols::Symbols;
 use super::{Compiler, is_zero};
 use crate::diag::{Collector, Reported};
@@ -68,15 +68,16 @@ pub fn collision(
 
 /// q̈ of G q̈ + h = Aᵀλ, A q̈ + Ȧq̇ = 0 by elimination (G = LDLᵀ and the
 /// constrained solve written out over one program for G, A, h and Ȧq̇), for
-/// a model whose q̈ has no exact closed form. `None` where a pivot is
-/// structurally zero.
+/// a model whose q̈ has no exact closed form, with that program and where
+/// it places G and h (Taylor's method may solve per order instead). `None`
+/// where a pivot is structurally zero.
 pub fn motion(
     exact: &Exact,
     raw: &Raw,
     compile: &Compiler,
     cx: &mut Collector,
     span: &Range<usize>,
-) -> Result<Option<Function>, Reported> {
+) -> Result<Option<(Function, MotionSystem)>, Reported> {
     let mut outputs = Outputs::default();
     let layout = outputs.layout(exact, &raw.a_rows);
     let forcing: Vec<Option<usize>> = raw.forcing.iter().map(|h| outputs.place(h)).collect();
@@ -91,7 +92,14 @@ pub fn motion(
     };
     Ok(f.program
         .motion_by_elimination(&layout, &forcing, &drift)
-        .map(|program| Function { program, ..f }))
+        .map(|program| {
+            let system = MotionSystem {
+                program: f.program.clone(),
+                layout,
+                forcing,
+            };
+            (Function { program, ..f }, system)
+        }))
 }
 
 /// The cheapest candidate per call (parameter-only work done once, as

@@ -34,7 +34,9 @@ use std::ops::Range;
 
 use symbolica::prelude::*;
 
-pub use output::{Choice, Derivation, Form, Function, Geometry, Projection, WallDerivation};
+pub use output::{
+    Choice, Derivation, Form, Function, Geometry, MotionSystem, Projection, WallDerivation,
+};
 pub use symbols::sample_configuration;
 
 use crate::diag::{Collector, ErrorKind, ModelErrors, Reported};
@@ -103,11 +105,15 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
     ] {
         functions.push(compile.applicable(cx, quantity, &outputs, rows, t_span)?);
     }
+    let mut motion_system = None;
     match &accelerations {
         Some(x) => functions.push(compile.applicable(cx, Quantity::Accelerations, x, 0, t_span)?),
         // No exact closed form (a dense G): the solve written out.
         None if model.kind == Kind::Coordinates && raw.drift.len() >= raw.a_rows.len() => {
-            functions.push(elimination::motion(&exact, &raw, &compile, cx, t_span)?)
+            if let Some((f, system)) = elimination::motion(&exact, &raw, &compile, cx, t_span)? {
+                functions.push(Some(f));
+                motion_system = Some(system);
+            }
         }
         None => {}
     }
@@ -121,6 +127,7 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
         accelerations: accelerations.map(|x| x.iter().map(|a| a.to_string()).collect()),
         walls,
         functions,
+        motion_system,
     })
 }
 

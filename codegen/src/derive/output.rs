@@ -4,7 +4,7 @@
 //! come from the same expressions.
 
 use crate::ir::Model;
-use crate::program::{Program, Transform};
+use crate::program::{Layout, Program, Transform};
 use crate::quantity::Quantity;
 
 /// Everything derived for one model.
@@ -26,6 +26,20 @@ pub struct Derivation {
     /// The model-wide emitted functions, in [`crate::quantity::TABLE`]
     /// order.
     pub functions: Vec<Function>,
+    /// Where q̈ is written out by elimination: the system it solves.
+    pub motion_system: Option<MotionSystem>,
+}
+
+/// G q̈ + h = Aᵀλ, A q̈ + Ȧq̇ = 0 as a program and where its outputs are.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MotionSystem {
+    /// G's lower triangle, A's rows, h and Ȧq̇ over (parameters,
+    /// coordinates, velocities).
+    pub program: Program,
+    /// Where G's entries and A's rows are among its outputs.
+    pub layout: Layout,
+    /// Where h's entries are.
+    pub forcing: Vec<Option<usize>>,
 }
 
 /// One emitted function: which quantity, and its program.
@@ -156,13 +170,25 @@ impl WallDerivation {
 impl Derivation {
     /// The Taylor transforms of q̈ and of each wall's f, which both back
     /// ends turn into the model's series (`None` where q̈ is not written
-    /// out).
+    /// out). Where q̈ is written out by elimination without constraint
+    /// rows, its series is that of G and h with the solve per order
+    /// ([`Program::taylor_solve`]) if that costs less at the default
+    /// tolerance's order than the elimination's own transform.
     pub fn series(&self) -> Option<(Transform, Vec<Transform>)> {
         let (np, nq) = (self.model.params.len(), self.model.coordinates.len());
-        let motion = self
+        let plain = self
             .function(Quantity::Accelerations)?
             .program
             .taylor(np, nq);
+        let order = dalembert_runtime::simulate::Taylor::default().order();
+        let motion = match self
+            .motion_system
+            .as_ref()
+            .and_then(|s| s.program.taylor_solve(np, nq, &s.layout, &s.forcing))
+        {
+            Some(solved) if solved.cost(order) < plain.cost(order) => solved,
+            _ => plain,
+        };
         let walls = self
             .walls
             .iter()

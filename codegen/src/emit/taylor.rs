@@ -13,7 +13,7 @@ use quote::{format_ident, quote};
 
 use super::Ctx;
 use super::body::{self, Place};
-use crate::program::{Emit, Op, Program, Series, Slot, Term, Transform};
+use crate::program::{Emit, Op, Program, Series, Slot, Solve, Term, Transform};
 
 /// The model's transforms: q̈'s, then each wall's f's (`None` for f32 or
 /// where q̈ is not written out: then the model has no series at all).
@@ -50,10 +50,18 @@ pub(super) fn functions(d: &Ctx) -> TokenStream {
             s.v[#i_lit][k + 1] = #out;
         }
     });
+    let how: &[&str] = if motion.solve.is_some() {
+        &[
+            " `taylor::MAX_ORDER`) by the Taylor transform of G and h",
+            " (`mass_matrix`, `forcing`) with G q̈ = −h solved at each order,",
+        ]
+    } else {
+        &[" `taylor::MAX_ORDER`) by the Taylor transform of `accelerations`,"]
+    };
     let motion_fn = quote! {
         /// The Taylor series of the motion through the state at order 0 of
         /// `s` (q(t₀), q̇(t₀)): fills its orders 1 to `order` (at most
-        /// `taylor::MAX_ORDER`) by the Taylor transform of `accelerations`,
+        #(#[doc = #how])*
         /// one order at a time.
         #[allow(unused_variables, clippy::approx_constant, clippy::needless_range_loop, clippy::manual_memcpy)]
         pub fn motion_series(&self, s: &mut ::dalembert_runtime::taylor::Series<#n>, order: usize) {
@@ -131,7 +139,12 @@ fn prelude(d: &Ctx, t: &Transform) -> TokenStream {
         let w = format_ident!("w{index}");
         quote! { let mut #w: ::dalembert_runtime::taylor::Coefficients = [0.0; ::dalembert_runtime::taylor::CAPACITY]; }
     });
-    quote! { #(#params)* #numbers #(#temps)* #(#weights)* }
+    let factor = t.solve.as_ref().map(|solve| {
+        let n = solve.x.len();
+        let len = Literal::usize_unsuffixed(n * (n + 1) / 2);
+        quote! { let mut factor = [0.0f64; #len]; }
+    });
+    quote! { #(#params)* #numbers #(#temps)* #(#weights)* #factor }
 }
 
 /// Whether an op's history is weighted by j (it keeps the series j·xⱼ of
@@ -189,9 +202,10 @@ fn output(d: &Ctx, t: &Transform, o: usize) -> TokenStream {
 /// Order k of every op: at k = 0 the values, beyond it the fused history
 /// loops and each op's finish.
 fn ops(d: &Ctx, t: &Transform) -> TokenStream {
-    if t.ops
-        .iter()
-        .all(|op| linear(d, &t.numbers, op, At::Any).is_some())
+    if t.solve.is_none()
+        && t.ops
+            .iter()
+            .all(|op| linear(d, &t.numbers, op, At::Any).is_some())
     {
         // Sums and scalings only: one statement per op at every order.
         let stmts = t
@@ -303,7 +317,54 @@ fn order_zero(d: &Ctx, t: &Transform) -> TokenStream {
             Op::Add { .. } | Op::Scale { .. } => unreachable!("linear ops above"),
         }
     });
-    quote! { #(#stmts)* }
+    let solve = t.solve.as_ref().map(|solve| {
+        let n = solve.x.len();
+        let n_lit = Literal::usize_unsuffixed(n);
+        let lower = (0..n).flat_map(|i| (0..=i).map(move |j| (i, j)));
+        let entries = lower.map(|(i, j)| coefficient(d, t, &solve.g[i][j], At::Zero));
+        let rhs = solve.h.iter().map(|h| coefficient(d, t, h, At::Zero));
+        let store = store_x(solve);
+        quote! {
+            factor = [#(#entries),*];
+            #tay::ldl_factor(&mut factor, #n_lit);
+            let mut rhs = [#(#rhs),*];
+            #tay::ldl_solve(&factor, &mut rhs);
+            #store
+        }
+    });
+    quote! { #(#stmts)* #solve }
+}
+
+/// Coefficient 0 (`At::Zero`) or k ≥ 1 (`At::Beyond`) of an entry of a
+/// solve (`None`: zero).
+fn coefficient(d: &Ctx, t: &Transform, term: &Option<Term>, at: At) -> TokenStream {
+    let k = if at == At::Zero {
+        quote! { 0 }
+    } else {
+        quote! { k }
+    };
+    match *term {
+        None => quote! { 0.0 },
+        Some(Term::Number(s)) if at == At::Zero => number(d, &t.numbers, s),
+        Some(Term::Number(_)) => quote! { 0.0 },
+        Some(Term::Series(s)) => {
+            let s = series(s);
+            quote! { #s[#k] }
+        }
+        Some(Term::Negated(s)) => {
+            let s = series(s);
+            quote! { (-#s[#k]) }
+        }
+    }
+}
+
+/// x's coefficient k from the solve's `rhs`.
+fn store_x(solve: &Solve) -> TokenStream {
+    let stores = solve.x.iter().enumerate().map(|(i, x)| {
+        let (x, i) = (series(*x), Literal::usize_unsuffixed(i));
+        quote! { #x[k] = rhs[#i]; }
+    });
+    quote! { #(#stores)* }
 }
 
 /// Orders k ≥ 1: the history loops (one accumulator per history, at most
@@ -389,6 +450,32 @@ fn order_k(d: &Ctx, t: &Transform) -> (TokenStream, TokenStream) {
             }
         })
         .collect();
+    // The solve: hₖ − (history + Gₖx₀) per entry of G that varies, in row
+    // order (a negated entry added), then the triangular solves.
+    let solve = t.solve.as_ref().map(|solve| {
+        let mut rows: Vec<TokenStream> = solve
+            .h
+            .iter()
+            .map(|h| coefficient(d, t, h, At::Beyond))
+            .collect();
+        for (i, m, g, minus) in solve.varying() {
+            let (g, x) = (series(g), series(solve.x[m]));
+            let h = history(quote! { #g[j] * #x[r] });
+            let term = quote! { (#h + #g[k] * #x[0]) };
+            let row = &rows[i];
+            rows[i] = if minus {
+                quote! { #row + #term }
+            } else {
+                quote! { #row - #term }
+            };
+        }
+        let store = store_x(solve);
+        quote! {
+            let mut rhs = [#(#rows),*];
+            #tay::ldl_solve(&factor, &mut rhs);
+            #store
+        }
+    });
     // One loop per group of histories: enough independent sums to keep the
     // floating-point units busy, few enough that they stay in registers.
     let fused = accs
@@ -403,7 +490,7 @@ fn order_k(d: &Ctx, t: &Transform) -> (TokenStream, TokenStream) {
                 }
             }
         });
-    (quote! { #(#fused)* }, quote! { #(#finishes)* })
+    (quote! { #(#fused)* }, quote! { #(#finishes)* #solve })
 }
 
 /// dst[0] = f(&dst, &a, [extra,] 0): a recurrence on its own result, at

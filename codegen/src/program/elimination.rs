@@ -27,7 +27,8 @@ pub struct Layout {
 }
 
 impl Layout {
-    fn g(&self, i: usize, j: usize) -> Option<usize> {
+    /// Where G's entry (i, j) is among the outputs (either triangle).
+    pub fn entry(&self, i: usize, j: usize) -> Option<usize> {
         let (i, j) = if i >= j { (i, j) } else { (j, i) };
         self.g[i * (i + 1) / 2 + j]
     }
@@ -223,7 +224,7 @@ impl Program {
             next: base + self.outputs,
         };
         let output = |e: Option<usize>| e.map(|k| Slot::Temp(base + k));
-        let lg = w.factorise(n, |i, j| output(layout.g(i, j)))?;
+        let lg = w.factorise(n, |i, j| output(layout.entry(i, j)))?;
         let rows = layout
             .rows
             .iter()

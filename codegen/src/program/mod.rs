@@ -15,7 +15,7 @@ use std::collections::HashMap;
 pub use elimination::Layout;
 pub use hoist::{Emit, Role, Split};
 pub use linear::{Entry, stored_signs};
-pub use taylor::{Evaluation, Op, Series, Term, Transform};
+pub use taylor::{Evaluation, Op, Series, Solve, Term, Transform};
 
 /// Where a value lives.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

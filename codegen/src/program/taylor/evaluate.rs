@@ -21,11 +21,15 @@ pub struct Evaluation {
     pub v: Vec<Coefficients>,
     /// Coefficients of each intermediate series.
     pub temps: Vec<Coefficients>,
+    /// G₀ factored, where the transform ends in a [`super::Solve`].
+    pub factor: Vec<f64>,
+    /// The solve's right-hand side.
+    pub rhs: Vec<f64>,
 }
 
 impl Evaluation {
     /// The coefficients of series `s`.
-    fn series(&self, s: Series) -> &Coefficients {
+    pub(super) fn series(&self, s: Series) -> &Coefficients {
         match s {
             Series::Q(i) => &self.q[i],
             Series::V(i) => &self.v[i],
@@ -113,6 +117,9 @@ impl Transform {
                 unreachable!("ops other than sin/cos write one temporary")
             };
             e.temps[d][k] = value;
+        }
+        if let Some(solve) = &self.solve {
+            solve.order(self, e, numbers, k);
         }
     }
 

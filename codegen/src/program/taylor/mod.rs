@@ -21,7 +21,9 @@ use super::{Func, Instr, Program, Slot, constant};
 mod evaluate;
 mod negations;
 mod quotients;
+mod solve;
 pub use evaluate::Evaluation;
+pub use solve::Solve;
 
 /// A series the transform reads or writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -101,6 +103,10 @@ pub struct Transform {
     pub ops: Vec<Op>,
     /// Each output of the program.
     pub outputs: Vec<Term>,
+    /// For q̈ solved per order ([`Program::taylor_solve`]): the solve
+    /// that follows the ops at each order and writes the series the
+    /// outputs read.
+    pub solve: Option<Solve>,
 }
 
 impl Program {
@@ -164,6 +170,7 @@ impl<'a> Builder<'a> {
             temps,
             ops,
             outputs,
+            solve: None,
         }
     }
 
@@ -404,17 +411,23 @@ impl Transform {
     }
 
     /// Its series operations per order and, of them, its convolutions: for
-    /// the generated file's header and the model's `series_work`.
+    /// the generated file's header and the model's `series_work`. A
+    /// [`Solve`] counts a convolution per entry of G that varies (its
+    /// history) and n² operations (the two triangular solves).
     pub fn work(&self) -> Work {
+        let (entries, n) = self
+            .solve
+            .as_ref()
+            .map_or((0, 0), |s| (s.varying().count(), s.x.len()));
         Work {
-            operations: self.ops.len(),
-            convolutions: self.convolutions(),
+            operations: self.ops.len() + entries + n * n,
+            convolutions: self.convolutions() + entries,
         }
     }
 
     /// How many of its series operations are convolutions (a loop over the
     /// coefficients so far, where the others take one step per order).
-    pub fn convolutions(&self) -> usize {
+    fn convolutions(&self) -> usize {
         self.ops
             .iter()
             .filter(|op| !matches!(op, Op::Add { .. } | Op::Scale { .. }))
@@ -443,6 +456,11 @@ impl Transform {
             if !matches!(op, Op::Mul { .. } | Op::Square { .. }) {
                 op.writes().iter().for_each(&mut keep);
             }
+        }
+        // A solve reads G's and x's lower coefficients (h's current one).
+        if let Some(solve) = &self.solve {
+            solve.varying().for_each(|(_, _, s, _)| keep(&s));
+            solve.x.iter().for_each(&mut keep);
         }
         only
     }
@@ -542,6 +560,7 @@ mod tests {
             q: vec![[0.0; tay::CAPACITY]],
             v: vec![],
             temps: vec![],
+            ..Evaluation::default()
         };
         e.q[0][0] = 2.0;
         e.q[0][1] = 1.0;

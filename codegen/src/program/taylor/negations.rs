@@ -177,6 +177,7 @@ mod tests {
             q: a.to_vec(),
             v: vec![],
             temps: vec![[0.0; tay::CAPACITY]; tr.temps],
+            ..Evaluation::default()
         };
         let mut got = [[0.0; tay::CAPACITY]; 2];
         for k in 0..=order {

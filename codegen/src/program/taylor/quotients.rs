@@ -125,6 +125,7 @@ mod tests {
             q: vec![[0.0; tay::CAPACITY]],
             v: vec![],
             temps: vec![],
+            ..Evaluation::default()
         };
         e.q[0][0] = 2.0;
         e.q[0][1] = 1.0;
