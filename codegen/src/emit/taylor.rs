@@ -182,21 +182,10 @@ fn zero_output(t: &Transform, o: usize) -> bool {
 
 /// Coefficient k of output `o`.
 fn output(d: &Ctx, t: &Transform, o: usize) -> TokenStream {
-    match t.outputs[o] {
-        _ if zero_output(t, o) => quote! { 0.0 },
-        Term::Number(s) => {
-            let x = number(d, &t.numbers, s);
-            quote! { (if k == 0 { #x } else { 0.0 }) }
-        }
-        Term::Series(s) => {
-            let s = series(s);
-            quote! { #s[k] }
-        }
-        Term::Negated(s) => {
-            let s = series(s);
-            quote! { (-#s[k]) }
-        }
+    if zero_output(t, o) {
+        return quote! { 0.0 };
     }
+    coefficient(d, t, &Some(t.outputs[o]), At::Any)
 }
 
 /// Order k of every op: at k = 0 the values, beyond it the fused history
@@ -335,8 +324,8 @@ fn order_zero(d: &Ctx, t: &Transform) -> TokenStream {
     quote! { #(#stmts)* #solve }
 }
 
-/// Coefficient 0 (`At::Zero`) or k ≥ 1 (`At::Beyond`) of an entry of a
-/// solve (`None`: zero).
+/// Coefficient 0 (`At::Zero`), k ≥ 1 (`At::Beyond`) or k (`At::Any`) of a
+/// term (`None`: zero): an output, or an entry of a solve.
 fn coefficient(d: &Ctx, t: &Transform, term: &Option<Term>, at: At) -> TokenStream {
     let k = if at == At::Zero {
         quote! { 0 }
@@ -345,8 +334,14 @@ fn coefficient(d: &Ctx, t: &Transform, term: &Option<Term>, at: At) -> TokenStre
     };
     match *term {
         None => quote! { 0.0 },
-        Some(Term::Number(s)) if at == At::Zero => number(d, &t.numbers, s),
-        Some(Term::Number(_)) => quote! { 0.0 },
+        Some(Term::Number(s)) => {
+            let x = number(d, &t.numbers, s);
+            match at {
+                At::Zero => x,
+                At::Beyond => quote! { 0.0 },
+                At::Any => quote! { (if k == 0 { #x } else { 0.0 }) },
+            }
+        }
         Some(Term::Series(s)) => {
             let s = series(s);
             quote! { #s[#k] }

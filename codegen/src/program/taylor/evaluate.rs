@@ -125,7 +125,18 @@ impl Transform {
 
     /// Coefficient k of output `o`.
     pub fn output(&self, e: &Evaluation, numbers: &[f64], o: usize, k: usize) -> f64 {
-        match self.outputs[o] {
+        self.coefficient(e, numbers, &self.outputs[o], k)
+    }
+
+    /// Coefficient k of a term (an output, or an entry of a solve).
+    pub(super) fn coefficient(
+        &self,
+        e: &Evaluation,
+        numbers: &[f64],
+        term: &Term,
+        k: usize,
+    ) -> f64 {
+        match *term {
             Term::Number(s) if k == 0 => numbers[self.number_index(s)],
             Term::Number(_) => 0.0,
             Term::Series(s) => e.series(s)[k],

@@ -74,12 +74,9 @@ impl Solve {
     /// G₀ is factored into `e.factor`.
     pub(super) fn order(&self, t: &Transform, e: &mut Evaluation, numbers: &[f64], k: usize) {
         let n = self.x.len();
-        let coefficient = |e: &Evaluation, term: &Option<Term>, k: usize| match *term {
-            None => 0.0,
-            Some(Term::Number(s)) if k == 0 => numbers[t.number_index(s)],
-            Some(Term::Number(_)) => 0.0,
-            Some(Term::Series(s)) => e.series(s)[k],
-            Some(Term::Negated(s)) => -e.series(s)[k],
+        let coefficient = |e: &Evaluation, term: &Option<Term>, k: usize| {
+            term.as_ref()
+                .map_or(0.0, |term| t.coefficient(e, numbers, term, k))
         };
         // The right-hand side in a buffer kept with the evaluation.
         let mut rhs = std::mem::take(&mut e.rhs);
