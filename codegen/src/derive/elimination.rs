@@ -96,10 +96,34 @@ pub fn motion(
             let system = MotionSystem {
                 program: f.program.clone(),
                 layout,
-                forcing,
+                rhs: forcing,
+                momentum: false,
             };
             (Function { program, ..f }, system)
         }))
+}
+
+/// Without constraints, the motion as G q̇ = p with ṗ = ∂L/∂q: one program
+/// for G's lower triangle and `gradient` (∂L/∂q, entry by entry).
+pub fn momentum(
+    exact: &Exact,
+    gradient: &[Atom],
+    compile: &Compiler,
+    cx: &mut Collector,
+    span: &Range<usize>,
+) -> Result<Option<MotionSystem>, Reported> {
+    let mut outputs = Outputs::default();
+    let layout = outputs.layout(exact, &[]);
+    let rhs: Vec<Option<usize>> = gradient.iter().map(|f| outputs.place(f)).collect();
+    let Some(f) = compile.applicable(cx, Quantity::Accelerations, &outputs.0, 0, span)? else {
+        return Ok(None);
+    };
+    Ok(Some(MotionSystem {
+        program: f.program,
+        layout,
+        rhs,
+        momentum: true,
+    }))
 }
 
 /// The cheapest candidate per call (parameter-only work done once, as

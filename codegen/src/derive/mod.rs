@@ -105,14 +105,24 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
     ] {
         functions.push(compile.applicable(cx, quantity, &outputs, rows, t_span)?);
     }
-    let mut motion_system = None;
+    let mut motion_systems = Vec::new();
     match &accelerations {
         Some(x) => functions.push(compile.applicable(cx, Quantity::Accelerations, x, 0, t_span)?),
         // No exact closed form (a dense G): the solve written out.
         None if model.kind == Kind::Coordinates && raw.drift.len() >= raw.a_rows.len() => {
             if let Some((f, system)) = elimination::motion(&exact, &raw, &compile, cx, t_span)? {
                 functions.push(Some(f));
-                motion_system = Some(system);
+                motion_systems.push(system);
+                if raw.a_rows.is_empty() {
+                    // ∂L/∂q for the momentum's series.
+                    let gradient: Vec<Atom> = sym
+                        .coords
+                        .iter()
+                        .map(|q| raw.t.derivative(*q) - raw.v.derivative(*q))
+                        .collect();
+                    let m = elimination::momentum(&exact, &gradient, &compile, cx, t_span)?;
+                    motion_systems.extend(m);
+                }
             }
         }
         None => {}
@@ -127,7 +137,7 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
         accelerations: accelerations.map(|x| x.iter().map(|a| a.to_string()).collect()),
         walls,
         functions,
-        motion_system,
+        motion_systems,
     })
 }
 

@@ -26,20 +26,25 @@ pub struct Derivation {
     /// The model-wide emitted functions, in [`crate::quantity::TABLE`]
     /// order.
     pub functions: Vec<Function>,
-    /// Where q̈ is written out by elimination: the system it solves.
-    pub motion_system: Option<MotionSystem>,
+    /// Where q̈ is written out by elimination: the system it solves, and
+    /// without constraints the same motion as the momentum's.
+    pub motion_systems: Vec<MotionSystem>,
 }
 
-/// G q̈ + h = Aᵀλ, A q̈ + Ȧq̇ = 0 as a program and where its outputs are.
+/// The motion as a linear system, a program and where its outputs are:
+/// G q̈ + h = Aᵀλ, A q̈ + Ȧq̇ = 0, or without constraints G q̇ = p with
+/// ṗ = ∂L/∂q (L = T − V).
 #[derive(Debug, Clone, PartialEq)]
 pub struct MotionSystem {
-    /// G's lower triangle, A's rows, h and Ȧq̇ over (parameters,
-    /// coordinates, velocities).
+    /// G's lower triangle, A's rows and the right-hand sides (h and Ȧq̇,
+    /// or ∂L/∂q) over (parameters, coordinates, velocities).
     pub program: Program,
     /// Where G's entries and A's rows are among its outputs.
     pub layout: Layout,
-    /// Where h's entries are.
-    pub forcing: Vec<Option<usize>>,
+    /// Where h's entries are, or ∂L/∂q's.
+    pub rhs: Vec<Option<usize>>,
+    /// Whether `rhs` is ∂L/∂q.
+    pub momentum: bool,
 }
 
 /// One emitted function: which quantity, and its program.
@@ -171,9 +176,10 @@ impl Derivation {
     /// The Taylor transforms of q̈ and of each wall's f, which both back
     /// ends turn into the model's series (`None` where q̈ is not written
     /// out). Where q̈ is written out by elimination without constraint
-    /// rows, its series is that of G and h with the solve per order
-    /// ([`Program::taylor_solve`]) if that costs less at the default
-    /// tolerance's order than the elimination's own transform.
+    /// rows, its series is that of G and h, or of G and ∂L/∂q, with the
+    /// solve per order ([`Program::taylor_solve`]), whichever of these and
+    /// the elimination's own transform costs least at the default
+    /// tolerance's order (the first on a tie).
     pub fn series(&self) -> Option<(Transform, Vec<Transform>)> {
         let (np, nq) = (self.model.params.len(), self.model.coordinates.len());
         let plain = self
@@ -181,14 +187,14 @@ impl Derivation {
             .program
             .taylor(np, nq);
         let order = dalembert_runtime::simulate::Taylor::default().order();
-        let motion = match self
-            .motion_system
-            .as_ref()
-            .and_then(|s| s.program.taylor_solve(np, nq, &s.layout, &s.forcing))
-        {
-            Some(solved) if solved.cost(order) < plain.cost(order) => solved,
-            _ => plain,
-        };
+        let solved = self.motion_systems.iter().filter_map(|s| {
+            s.program
+                .taylor_solve(np, nq, &s.layout, &s.rhs, s.momentum)
+        });
+        let motion = std::iter::once(plain)
+            .chain(solved)
+            .min_by_key(|t| t.cost(order))
+            .expect("the elimination's transform at least");
         let walls = self
             .walls
             .iter()

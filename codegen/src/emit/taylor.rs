@@ -8,6 +8,8 @@
 //! program order (`dalembert_runtime::taylor`'s `*_finish`). f64 only (the
 //! runtime's series are f64).
 
+use std::ops::Range;
+
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
@@ -35,6 +37,11 @@ pub(super) fn functions(d: &Ctx) -> TokenStream {
     };
     let n = Literal::usize_unsuffixed(d.model.velocities.len());
     let motion_prelude = prelude(d, &motion);
+    if let Some(solve) = motion.solve.as_ref().filter(|s| s.momentum) {
+        let walls = wall_functions(d, &walls, &n);
+        let motion_fn = momentum_series(d, &motion, solve, motion_prelude, &n);
+        return quote! { #motion_fn #walls };
+    }
     let motion_ops = ops(d, &motion);
     let feedback = (0..d.model.velocities.len()).map(|i| {
         let i_lit = Literal::usize_unsuffixed(i);
@@ -75,7 +82,13 @@ pub(super) fn functions(d: &Ctx) -> TokenStream {
             s.order = order;
         }
     };
-    let wall_fns = d.walls.iter().zip(&walls).map(|(w, t)| {
+    let wall_fns = wall_functions(d, &walls, &n);
+    quote! { #motion_fn #wall_fns }
+}
+
+/// Every `{wall}_surface_series`.
+fn wall_functions(d: &Ctx, walls: &[Transform], n: &Literal) -> TokenStream {
+    let wall_fns = d.walls.iter().zip(walls).map(|(w, t)| {
         let name = format_ident!("{}_surface_series", w.name);
         let doc = format!(
             " Wall `{}`: the Taylor coefficients of f(q(t)) along `s`, orders 0 to `s.order`.",
@@ -100,7 +113,56 @@ pub(super) fn functions(d: &Ctx) -> TokenStream {
             }
         }
     });
-    quote! { #motion_fn #(#wall_fns)* }
+    quote! { #(#wall_fns)* }
+}
+
+/// `motion_series` where the series of the momentum p = G q̇ is followed
+/// (ṗ = ∂L/∂q, the solve's right-hand side): at each order k the ops
+/// that read coordinates only (G's among them), then G₀ q̇ₖ = pₖ −
+/// Σⱼ₌₁..ₖ Gⱼ q̇ₖ₋ⱼ (k ≥ 1; G₀ factored at k = 0), then the ops that read
+/// velocities, then qₖ₊₁ = q̇ₖ/(k + 1) and pₖ₊₁ = (∂L/∂q)ₖ/(k + 1); one
+/// more order of the first ops and the solve gives q̇ at the last order.
+fn momentum_series(
+    d: &Ctx,
+    t: &Transform,
+    solve: &Solve,
+    prelude: TokenStream,
+    n: &Literal,
+) -> TokenStream {
+    let before = ops_in(d, t, 0..solve.split, true);
+    let after = ops_in(d, t, solve.split..t.ops.len(), false);
+    let feedback = solve.rhs.iter().enumerate().map(|(i, f)| {
+        let i = Literal::usize_unsuffixed(i);
+        let f = coefficient(d, t, f, At::Any);
+        quote! {
+            s.q[#i][k + 1] = s.v[#i][k] * ik;
+            p[#i] = #f * ik;
+        }
+    });
+    quote! {
+        /// The Taylor series of the motion through the state at order 0 of
+        /// `s` (q(t₀), q̇(t₀)): fills its orders 1 to `order` (at most
+        /// `taylor::MAX_ORDER`) by the Taylor transform of G and ∂L/∂q
+        /// (`mass_matrix`, the gradient of T − V), following the momentum
+        /// p = G q̇ (ṗ = ∂L/∂q) with G q̇ = p solved at each order, one
+        /// order at a time.
+        #[allow(unused_variables, clippy::approx_constant, clippy::needless_range_loop, clippy::manual_memcpy)]
+        pub fn motion_series(&self, s: &mut ::dalembert_runtime::taylor::Series<#n>, order: usize) {
+            let order = order.min(::dalembert_runtime::taylor::MAX_ORDER);
+            #prelude
+            let mut p = [0.0f64; #n];
+            for k in 0..=order {
+                #before
+                if k == order {
+                    break;
+                }
+                #after
+                let ik = ::dalembert_runtime::taylor::RECIPROCALS[k + 1];
+                #(#feedback)*
+            }
+            s.order = order;
+        }
+    }
 }
 
 /// The time-constant values and the zeroed intermediate series.
@@ -191,20 +253,27 @@ fn output(d: &Ctx, t: &Transform, o: usize) -> TokenStream {
 /// Order k of every op: at k = 0 the values, beyond it the fused history
 /// loops and each op's finish.
 fn ops(d: &Ctx, t: &Transform) -> TokenStream {
-    if t.solve.is_none()
-        && t.ops
+    ops_in(d, t, 0..t.ops.len(), t.solve.is_some())
+}
+
+/// [`ops`] for the ops in `range` only, followed by the transform's solve
+/// if `solve`.
+fn ops_in(d: &Ctx, t: &Transform, range: Range<usize>, solve: bool) -> TokenStream {
+    let group = &t.ops[range.clone()];
+    if !solve
+        && group
             .iter()
             .all(|op| linear(d, &t.numbers, op, At::Any).is_some())
     {
         // Sums and scalings only: one statement per op at every order.
-        let stmts = t
-            .ops
+        let stmts = group
             .iter()
             .flat_map(|op| linear(d, &t.numbers, op, At::Any));
         return quote! { #(#stmts)* };
     }
-    let zero = order_zero(d, t);
-    let (histories, finishes) = order_k(d, t);
+    let solve = if solve { t.solve.as_ref() } else { None };
+    let zero = order_zero(d, t, range.clone(), solve);
+    let (histories, finishes) = order_k(d, t, range, solve);
     quote! {
         if k == 0 {
             #zero
@@ -272,9 +341,9 @@ fn linear(d: &Ctx, p: &Program, op: &Op, at: At) -> Option<TokenStream> {
 }
 
 /// Order 0: each function's value (the runtime's recurrences at order 0).
-fn order_zero(d: &Ctx, t: &Transform) -> TokenStream {
+fn order_zero(d: &Ctx, t: &Transform, range: Range<usize>, solve: Option<&Solve>) -> TokenStream {
     let tay = quote! { ::dalembert_runtime::taylor };
-    let stmts = t.ops.iter().map(|op| {
+    let stmts = t.ops[range].iter().map(|op| {
         if let Some(l) = linear(d, &t.numbers, op, At::Zero) {
             return l;
         }
@@ -306,16 +375,23 @@ fn order_zero(d: &Ctx, t: &Transform) -> TokenStream {
             Op::Add { .. } | Op::Scale { .. } => unreachable!("linear ops above"),
         }
     });
-    let solve = t.solve.as_ref().map(|solve| {
+    let solve = solve.map(|solve| {
         let n = solve.x.len();
         let n_lit = Literal::usize_unsuffixed(n);
         let lower = (0..n).flat_map(|i| (0..=i).map(move |j| (i, j)));
         let entries = lower.map(|(i, j)| coefficient(d, t, &solve.g[i][j], At::Zero));
-        let rhs = solve.h.iter().map(|h| coefficient(d, t, h, At::Zero));
-        let store = store_x(solve);
-        quote! {
+        let factor = quote! {
             factor = [#(#entries),*];
             #tay::ldl_factor(&mut factor, #n_lit);
+        };
+        if solve.momentum {
+            // The velocities' order 0 is the state's.
+            return factor;
+        }
+        let rhs = solve.rhs.iter().map(|h| coefficient(d, t, h, At::Zero));
+        let store = store_x(solve);
+        quote! {
+            #factor
             let mut rhs = [#(#rhs),*];
             #tay::ldl_solve(&factor, &mut rhs);
             #store
@@ -365,7 +441,12 @@ fn store_x(solve: &Solve) -> TokenStream {
 /// Orders k ≥ 1: the history loops (one accumulator per history, at most
 /// [`HISTORIES_PER_LOOP`] per loop), then each op's finish in program
 /// order.
-fn order_k(d: &Ctx, t: &Transform) -> (TokenStream, TokenStream) {
+fn order_k(
+    d: &Ctx,
+    t: &Transform,
+    range: Range<usize>,
+    solve: Option<&Solve>,
+) -> (TokenStream, TokenStream) {
     let tay = quote! { ::dalembert_runtime::taylor };
     let mut accs = Vec::new();
     let mut terms = Vec::new();
@@ -375,11 +456,12 @@ fn order_k(d: &Ctx, t: &Transform) -> (TokenStream, TokenStream) {
         accs.push(h.clone());
         h
     };
-    let finishes: Vec<TokenStream> = t
-        .ops
+    let first = range.start;
+    let finishes: Vec<TokenStream> = t.ops[range]
         .iter()
         .enumerate()
-        .map(|(index, op)| {
+        .map(|(i, op)| {
+            let index = first + i;
             if let Some(l) = linear(d, &t.numbers, op, At::Beyond) {
                 return l;
             }
@@ -445,14 +527,24 @@ fn order_k(d: &Ctx, t: &Transform) -> (TokenStream, TokenStream) {
             }
         })
         .collect();
-    // The solve: hₖ − (history + Gₖx₀) per entry of G that varies, in row
-    // order (a negated entry added), then the triangular solves.
-    let solve = t.solve.as_ref().map(|solve| {
-        let mut rows: Vec<TokenStream> = solve
-            .h
-            .iter()
-            .map(|h| coefficient(d, t, h, At::Beyond))
-            .collect();
+    // The solve: hₖ (or pₖ) − (history + Gₖx₀) per entry of G that
+    // varies, in row order (a negated entry added), then the triangular
+    // solves.
+    let solve = solve.map(|solve| {
+        let mut rows: Vec<TokenStream> = if solve.momentum {
+            (0..solve.x.len())
+                .map(|i| {
+                    let i = Literal::usize_unsuffixed(i);
+                    quote! { p[#i] }
+                })
+                .collect()
+        } else {
+            solve
+                .rhs
+                .iter()
+                .map(|h| coefficient(d, t, h, At::Beyond))
+                .collect()
+        };
         for (i, m, g, minus) in solve.varying() {
             let (g, x) = (series(g), series(solve.x[m]));
             let h = history(quote! { #g[j] * #x[r] });

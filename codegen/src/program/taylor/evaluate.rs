@@ -4,6 +4,8 @@
 //! interpreter and the tests use it; emitted code does the same in
 //! straight-line Rust (`emit/taylor.rs`).
 
+use std::ops::Range;
+
 use dalembert_runtime::taylor::{self as tay, Coefficients};
 
 use super::{Op, Series, Term, Transform};
@@ -25,6 +27,8 @@ pub struct Evaluation {
     pub factor: Vec<f64>,
     /// The solve's right-hand side.
     pub rhs: Vec<f64>,
+    /// pₖ, where the series followed is the momentum's.
+    pub momentum: Vec<f64>,
 }
 
 impl Evaluation {
@@ -73,9 +77,18 @@ impl Transform {
         }
     }
 
-    /// Runs order k of every op on `e` (coefficients below k in place).
+    /// Runs order k of every op on `e` (coefficients below k in place),
+    /// and of a solve of h's.
     pub fn order(&self, e: &mut Evaluation, numbers: &[f64], k: usize) {
-        for op in &self.ops {
+        self.run_ops(e, numbers, k, 0..self.ops.len());
+        if let Some(solve) = self.solve.as_ref().filter(|s| !s.momentum) {
+            solve.order(self, e, numbers, k);
+        }
+    }
+
+    /// Runs order k of the ops in `range`.
+    fn run_ops(&self, e: &mut Evaluation, numbers: &[f64], k: usize, range: Range<usize>) {
+        for op in &self.ops[range] {
             // Operands by reference: a copy would move 256 bytes per operand.
             let get = |s: Series| e.series(s);
             let slot_value = |s: &Slot| numbers[self.number_index(*s)];
@@ -117,9 +130,6 @@ impl Transform {
                 unreachable!("ops other than sin/cos write one temporary")
             };
             e.temps[d][k] = value;
-        }
-        if let Some(solve) = &self.solve {
-            solve.order(self, e, numbers, k);
         }
     }
 
@@ -173,6 +183,28 @@ impl Transform {
             c[0] = *x;
         }
         let order = order.min(tay::MAX_ORDER);
+        if let Some(solve) = self.solve.as_ref().filter(|s| s.momentum) {
+            // As emitted code: the ops before the solve, the solve, the
+            // rest, then qₖ₊₁ and pₖ₊₁.
+            e.momentum.resize(v.len(), 0.0);
+            for k in 0..=order {
+                self.run_ops(e, numbers, k, 0..solve.split);
+                solve.order(self, e, numbers, k);
+                if k == order {
+                    break;
+                }
+                self.run_ops(e, numbers, k, solve.split..self.ops.len());
+                let ik = tay::RECIPROCALS[k + 1];
+                for i in 0..v.len() {
+                    e.q[i][k + 1] = e.v[i][k] * ik;
+                    let f = solve.rhs[i]
+                        .as_ref()
+                        .map_or(0.0, |f| self.coefficient(e, numbers, f, k));
+                    e.momentum[i] = f * ik;
+                }
+            }
+            return;
+        }
         for k in 0..order {
             self.order(e, numbers, k);
             let ik = tay::RECIPROCALS[k + 1];
