@@ -1,7 +1,10 @@
-//! q̈ of G q̈ + h = 0 solved order by order inside the series (the
-//! runtime's `taylor::ldl_factor` / `ldl_solve`): the transform of the
-//! program that computes G's lower triangle and h, followed by
-//! xₖ = G₀⁻¹(hₖ − Σⱼ₌₁..ₖ Gⱼ xₖ₋ⱼ) and q̈ₖ = −xₖ. Where the elimination
+//! The motion's series with a linear solve at each order (the runtime's
+//! `taylor::ldl_factor` / `ldl_solve`), for a q̈ that has no closed form.
+//! Either G q̈ + h = 0: the transform of the program that computes G's
+//! lower triangle and h, followed by xₖ = G₀⁻¹(hₖ − Σⱼ₌₁..ₖ Gⱼ xₖ₋ⱼ) and
+//! q̈ₖ = −xₖ. Or, without constraints, the momentum p = G q̇ with
+//! ṗ = ∂L/∂q, which needs G and ∂L/∂q only (h carries the time derivative
+//! of G q̇ as well): q̇ₖ = G₀⁻¹(pₖ − Σⱼ₌₁..ₖ Gⱼ q̇ₖ₋ⱼ). Where the elimination
 //! written out as straight-line code (`program/elimination.rs`) makes every
 //! pivot and multiplier of G's factorisation a series of its own, this
 //! factors G₀ once per series and costs per order one history for each
@@ -75,7 +78,10 @@ impl Program {
                     first.push(op);
                 }
             }
-            let reads_velocity = |k: &usize| matches!(t.outputs[*k], Term::Series(s) | Term::Negated(s) if moving.contains(&s));
+            let reads_velocity = |k: &usize| match t.outputs[*k] {
+                Term::Series(s) | Term::Negated(s) => moving.contains(&s),
+                Term::Number(_) => false,
+            };
             if layout.g.iter().flatten().any(reads_velocity) {
                 return None;
             }
