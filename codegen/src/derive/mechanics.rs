@@ -196,6 +196,16 @@ fn raw_wall(sym: &Symbols, cx: &mut Collector, w: &Wall) -> Result<RawWall, Repo
     })
 }
 
+/// ∂L/∂q = ∂T/∂q − ∂V/∂q, entry by entry: the momentum's rate ṗ where
+/// p = G q̇ and there are no constraints (Taylor's method can follow p
+/// instead of q̇, `program/taylor/solve.rs`).
+pub fn lagrangian_gradient(sym: &Symbols, raw: &Raw) -> Vec<Atom> {
+    sym.coords
+        .iter()
+        .map(|q| raw.t.derivative(*q) - raw.v.derivative(*q))
+        .collect()
+}
+
 /// The Lagrange–d'Alembert equations G q̈ + h = Aᵀλ with A q̇ = 0:
 /// hᵢ = Σₖ ∂²T/∂q̇ᵢ∂qₖ q̇ₖ − ∂T/∂qᵢ + ∂V/∂qᵢ, and differentiating A q̇ = 0
 /// in time gives A q̈ + Ȧq̇ = 0 with (Ȧq̇)ᵣ = Σⱼ ∂(Aᵣq̇)/∂qⱼ q̇ⱼ.

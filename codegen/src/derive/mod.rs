@@ -114,12 +114,7 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
                 functions.push(Some(f));
                 motion_systems.push(system);
                 if raw.a_rows.is_empty() {
-                    // ∂L/∂q for the momentum's series.
-                    let gradient: Vec<Atom> = sym
-                        .coords
-                        .iter()
-                        .map(|q| raw.t.derivative(*q) - raw.v.derivative(*q))
-                        .collect();
+                    let gradient = mechanics::lagrangian_gradient(&sym, &raw);
                     let m = elimination::momentum(&exact, &gradient, &compile, cx, t_span)?;
                     motion_systems.extend(m);
                 }

@@ -25,7 +25,7 @@ use quote::{format_ident, quote};
 use crate::Generated;
 use crate::derive::Derivation;
 use crate::ir::camel;
-use crate::program::{OpCount, Split};
+use crate::program::{OpCount, Split, Transform};
 
 use body::{lit, real};
 
@@ -58,6 +58,9 @@ struct Ctx<'a> {
     splits: HashMap<String, Split>,
     /// Precomputed values in all.
     stored: usize,
+    /// The Taylor transforms of q̈ and of each wall's f
+    /// ([`Derivation::series`], worked out once; `None` for f32).
+    series: Option<(Transform, Vec<Transform>)>,
 }
 
 impl<'a> Ctx<'a> {
@@ -70,11 +73,13 @@ impl<'a> Ctx<'a> {
             stored += split.stored;
             splits.insert(name, split);
         }
+        let series = (scalar == Scalar::F64).then(|| d.series()).flatten();
         Self {
             d,
             scalar,
             splits,
             stored,
+            series,
         }
     }
 
@@ -158,7 +163,7 @@ fn header(d: &Ctx) -> String {
             "//   {:<28} {ops} ops, {loops} convolutions\n",
             "motion_series"
         ));
-        for (w, t) in d.walls.iter().zip(&walls) {
+        for (w, t) in d.walls.iter().zip(walls) {
             let work = t.work();
             let (ops, loops) = (work.operations, work.convolutions);
             let name = format!("{}_surface_series", w.name);

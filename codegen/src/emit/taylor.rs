@@ -19,11 +19,8 @@ use crate::program::{Emit, Op, Program, Series, Slot, Solve, Term, Transform};
 
 /// The model's transforms: q̈'s, then each wall's f's (`None` for f32 or
 /// where q̈ is not written out: then the model has no series at all).
-pub(super) fn transforms(d: &Ctx) -> Option<(Transform, Vec<Transform>)> {
-    if d.scalar != super::Scalar::F64 {
-        return None;
-    }
-    d.series()
+pub(super) fn transforms<'a>(d: &'a Ctx) -> Option<(&'a Transform, &'a [Transform])> {
+    d.series.as_ref().map(|(m, w)| (m, w.as_slice()))
 }
 
 /// Histories summed side by side in one loop over j: x86-64 has 16
@@ -36,20 +33,20 @@ pub(super) fn functions(d: &Ctx) -> TokenStream {
         return TokenStream::new();
     };
     let n = Literal::usize_unsuffixed(d.model.velocities.len());
-    let motion_prelude = prelude(d, &motion);
+    let motion_prelude = prelude(d, motion);
     if let Some(solve) = motion.solve.as_ref().filter(|s| s.momentum) {
-        let walls = wall_functions(d, &walls, &n);
-        let motion_fn = momentum_series(d, &motion, solve, motion_prelude, &n);
+        let walls = wall_functions(d, walls, &n);
+        let motion_fn = momentum_series(d, motion, solve, motion_prelude, &n);
         return quote! { #motion_fn #walls };
     }
-    let motion_ops = ops(d, &motion);
+    let motion_ops = ops(d, motion);
     let feedback = (0..d.model.velocities.len()).map(|i| {
         let i_lit = Literal::usize_unsuffixed(i);
         // A zero acceleration (a free coordinate) is zero at every order.
-        let out = if zero_output(&motion, i) {
+        let out = if zero_output(motion, i) {
             quote! { 0.0 }
         } else {
-            let out = output(d, &motion, i);
+            let out = output(d, motion, i);
             quote! { #out * ik }
         };
         quote! {
@@ -82,7 +79,7 @@ pub(super) fn functions(d: &Ctx) -> TokenStream {
             s.order = order;
         }
     };
-    let wall_fns = wall_functions(d, &walls, &n);
+    let wall_fns = wall_functions(d, walls, &n);
     quote! { #motion_fn #wall_fns }
 }
 
