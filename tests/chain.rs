@@ -158,3 +158,25 @@ fn mass_matrix_entries_keep_their_parameter_factor_once() {
         );
     }
 }
+
+/// Taylor's series need not follow q̈'s closed form: chain_4_symbolic's
+/// (its q̈ a closed form of hundreds of operations) solves G per order as
+/// chain_4's does, so the same model costs the same whichever way its
+/// parameters are written; and chain_3's closed form gives way to the
+/// solve as well, so the shorter chain's series costs less (its closed
+/// form's transform cost more than chain_4's solve).
+#[test]
+fn series_of_a_closed_form_solve_per_order_where_cheaper() {
+    let work = |w: Option<dalembert::runtime::taylor::SeriesWork>| {
+        w.expect("the chains have series").motion
+    };
+    let structured = work(Chain4::default().series_work());
+    let symbolic = work(Chain4Symbolic::default().series_work());
+    assert_eq!(symbolic, structured);
+    let chain_3 = work(Chain3::default().series_work());
+    let order = 21;
+    assert!(
+        chain_3.multiply_adds(order) < structured.multiply_adds(order),
+        "chain_3 {chain_3:?}, chain_4 {structured:?}"
+    );
+}

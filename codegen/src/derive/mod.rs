@@ -106,21 +106,33 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
         functions.push(compile.applicable(cx, quantity, &outputs, rows, t_span)?);
     }
     let mut motion_systems = Vec::new();
+    let moving = model.kind == Kind::Coordinates && raw.drift.len() >= raw.a_rows.len();
+    // Without constraint rows Taylor's method may solve G per order instead
+    // of following q̈'s own program, closed form or not: the systems of h
+    // and of the momentum, for `Derivation::series` to weigh.
+    let unconstrained = moving && raw.a_rows.is_empty();
     match &accelerations {
-        Some(x) => functions.push(compile.applicable(cx, Quantity::Accelerations, x, 0, t_span)?),
+        Some(x) => {
+            functions.push(compile.applicable(cx, Quantity::Accelerations, x, 0, t_span)?);
+            if unconstrained
+                && let Some((_, system)) = elimination::motion(&exact, &raw, &compile, cx, t_span)?
+            {
+                motion_systems.push(system);
+            }
+        }
         // No exact closed form (a dense G): the solve written out.
-        None if model.kind == Kind::Coordinates && raw.drift.len() >= raw.a_rows.len() => {
+        None if moving => {
             if let Some((f, system)) = elimination::motion(&exact, &raw, &compile, cx, t_span)? {
                 functions.push(Some(f));
                 motion_systems.push(system);
-                if raw.a_rows.is_empty() {
-                    let gradient = mechanics::lagrangian_gradient(&sym, &raw);
-                    let m = elimination::momentum(&exact, &gradient, &compile, cx, t_span)?;
-                    motion_systems.extend(m);
-                }
             }
         }
         None => {}
+    }
+    if unconstrained && !motion_systems.is_empty() {
+        let gradient = mechanics::lagrangian_gradient(&sym, &raw);
+        let m = elimination::momentum(&exact, &gradient, &compile, cx, t_span)?;
+        motion_systems.extend(m);
     }
     functions.push(initial_state(&sym, &compile, cx)?);
     let functions = functions.into_iter().flatten().collect();

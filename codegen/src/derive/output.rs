@@ -26,8 +26,9 @@ pub struct Derivation {
     /// The model-wide emitted functions, in [`crate::quantity::TABLE`]
     /// order.
     pub functions: Vec<Function>,
-    /// Where q̈ is written out by elimination: the system it solves, and
-    /// without constraints the same motion as the momentum's.
+    /// Where q̈ is written out by elimination: the system it solves; and
+    /// without constraints, closed form or not, G q̈ = −h and the same
+    /// motion as the momentum's, for Taylor's method to solve per order.
     pub motion_systems: Vec<MotionSystem>,
 }
 
@@ -175,11 +176,11 @@ impl WallDerivation {
 impl Derivation {
     /// The Taylor transforms of q̈ and of each wall's f, which both back
     /// ends turn into the model's series (`None` where q̈ is not written
-    /// out). Where q̈ is written out by elimination without constraint
-    /// rows, its series is that of G and h, or of G and ∂L/∂q, with the
-    /// solve per order ([`Program::taylor_solve`]), whichever of these and
-    /// the elimination's own transform costs least at the default
-    /// tolerance's order (the first on a tie).
+    /// out). Without constraint rows, the series of q̈ can also be that of
+    /// G and h, or of G and ∂L/∂q, with the solve per order
+    /// ([`Program::taylor_solve`]): the transform of q̈'s own program
+    /// (closed form or elimination) or of one of these systems, whichever
+    /// costs least at the default tolerance's order (q̈'s own on a tie).
     pub fn series(&self) -> Option<(Transform, Vec<Transform>)> {
         let (np, nq) = (self.model.params.len(), self.model.coordinates.len());
         let plain = self
