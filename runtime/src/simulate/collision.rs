@@ -22,18 +22,20 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         let k = located.wall;
         let step = located.t_hi - t0;
         let (tc, y) = self.polish(method, y0, t0, located)?;
-        let collision = self.land(k, tc, &y, t0, step)?;
+        let collision = self.land(k, (tc, 0.0), &y, t0, step)?;
         self.f0 = self.rhs(tc, &self.phase())?;
         Ok(collision)
     }
 
     /// The collision with wall `k` at (tc, y), found on a step of length
     /// `step` from t0: checked, mapped, and the simulator's state set to
-    /// just after it (projected onto the constraints).
+    /// just after it (projected onto the constraints). `tc` comes with its
+    /// rounding term (the compensated clock of Taylor's method, zero
+    /// otherwise), which becomes the clock's with the state.
     pub(super) fn land(
         &mut self,
         k: usize,
-        tc: f64,
+        (tc, t_low): (f64, f64),
         y: &Phase<N>,
         t0: f64,
         step: f64,
@@ -45,6 +47,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             q: y.q,
             v: collision.v_plus,
         };
+        self.t_low = t_low;
         self.departing |= 1 << k;
         // Go on with steps of at most twice the time since the previous
         // collision: an error-free stretch (a parabola) would otherwise let

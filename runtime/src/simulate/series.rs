@@ -179,22 +179,22 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         match found {
             Some((k, tau)) => {
                 let (q, v) = finite(self.series.state(tau), t0)?;
-                let tc = self.advance_time(tau);
+                let tc = self.time_after(tau);
                 let collision = self.land(k, tc, &Phase { q, v }, t0, h)?;
-                self.last = Some(last(tc));
+                self.last = Some(last(tc.0));
                 self.stats.collisions += 1;
                 Ok(self.report(t0, Some(collision)))
             }
             None => {
                 let (q, v) = finite(self.series.state(h), t0)?;
-                let t1 = if h >= left {
-                    self.t_low = 0.0;
-                    t_end
+                let (t1, low) = if h >= left {
+                    (t_end, 0.0)
                 } else {
-                    self.advance_time(h)
+                    self.time_after(h)
                 };
                 self.last = Some(last(t1));
                 self.state = State { t: t1, q, v };
+                self.t_low = low;
                 self.leave_walls();
                 self.project()?;
                 Ok(self.report(t0, None))
@@ -202,10 +202,12 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         }
     }
 
-    /// t + tau in compensated arithmetic (the error term kept in
-    /// `t_low`): the rounded sum of every step so far, not of the rounded
-    /// partial sums.
-    fn advance_time(&mut self, tau: f64) -> f64 {
+    /// t + tau in compensated arithmetic, with its error term for
+    /// `t_low`: the rounded sum of every step so far, not of the rounded
+    /// partial sums. Nothing is kept here: the pair becomes the clock only
+    /// with the state it belongs to, so a step that fails leaves no
+    /// rounding term behind.
+    fn time_after(&self, tau: f64) -> (f64, f64) {
         let t = self.state.t;
         let hi = t + tau;
         // Knuth's two-sum: the exact error of t + tau.
@@ -213,8 +215,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         let err = (t - (hi - b)) + (tau - b);
         let low = self.t_low + err;
         let sum = hi + low;
-        self.t_low = low - (sum - hi);
-        sum
+        (sum, low - (sum - hi))
     }
 }
 
