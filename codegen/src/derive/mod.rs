@@ -114,6 +114,8 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
     match &accelerations {
         Some(x) => {
             functions.push(compile.applicable(cx, Quantity::Accelerations, x, 0, t_span)?);
+            // h's system only: beside the closed form, the elimination's
+            // own q̈ is not emitted.
             if unconstrained
                 && let Some((_, system)) = elimination::motion(&exact, &raw, &compile, cx, t_span)?
             {
@@ -129,6 +131,8 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
         }
         None => {}
     }
+    // The momentum's system wherever h's is (G's pivots are not
+    // structurally zero).
     if unconstrained && !motion_systems.is_empty() {
         let gradient = mechanics::lagrangian_gradient(&sym, &raw);
         let m = elimination::momentum(&exact, &gradient, &compile, cx, t_span)?;
