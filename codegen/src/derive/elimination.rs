@@ -69,8 +69,9 @@ pub fn collision(
 /// q̈ of G q̈ + h = Aᵀλ, A q̈ + Ȧq̇ = 0 by elimination (G = LDLᵀ and the
 /// constrained solve written out over one program for G, A, h and Ȧq̇), for
 /// a model whose q̈ has no exact closed form, with that program and where
-/// it places G and h (Taylor's method may solve per order instead). `None`
-/// where a pivot is structurally zero.
+/// it places G and h (Taylor's method may solve per order instead; beside a
+/// closed form only that system is kept). `None` where a pivot is
+/// structurally zero.
 pub fn motion(
     exact: &Exact,
     raw: &Raw,

@@ -1,5 +1,7 @@
 //! The motion's series with a linear solve at each order (the runtime's
-//! `taylor::ldl_factor` / `ldl_solve`), for a q̈ that has no closed form.
+//! `taylor::ldl_factor` / `ldl_solve`), without constraint rows, where it
+//! costs less than the transform of q̈'s own program (closed form or
+//! elimination).
 //! Either G q̈ + h = 0: the transform of the program that computes G's
 //! lower triangle and h, followed by xₖ = G₀⁻¹(hₖ − Σⱼ₌₁..ₖ Gⱼ xₖ₋ⱼ) and
 //! q̈ₖ = −xₖ. Or, without constraints, the momentum p = G q̇ with
