@@ -32,7 +32,8 @@ impl<const N: usize> Row<N> {
     }
 }
 
-/// Rows kept in memory for the plot; the CSV has them all.
+/// Rows kept in memory for the plot (up to twice this many); the CSV has
+/// them all.
 const PLOT_ROWS: usize = 4000;
 
 /// Where the rows go: the CSV file as they come, a thinned copy for the
@@ -40,10 +41,15 @@ const PLOT_ROWS: usize = 4000;
 pub(super) struct Output<const N: usize> {
     file: std::io::BufWriter<std::fs::File>,
     path: PathBuf,
-    /// Rows for the plot: every `stride`-th row and every collision.
+    /// Rows for the plot: every `stride`-th row of a state, and every
+    /// `collision_stride`-th collision (each one while they take at most a
+    /// quarter of the budget; see [`Output::thin`]).
     pub(super) kept: Vec<Row<N>>,
     stride: usize,
+    collision_stride: usize,
+    /// Rows written in all, and of them collisions.
     pub(super) written: usize,
+    collisions: usize,
     pub(super) e0: f64,
     pub(super) drift: f64,
     pub(super) worst: [f64; 2],
@@ -58,7 +64,9 @@ impl<const N: usize> Output<N> {
             path: path.to_path_buf(),
             kept: Vec::new(),
             stride: 1,
+            collision_stride: 1,
             written: 0,
+            collisions: 0,
             e0,
             drift: 0.0,
             worst: [0.0; 2],
@@ -104,20 +112,48 @@ impl<const N: usize> Output<N> {
             self.worst[0].max(r.residual[0]),
             self.worst[1].max(r.residual[1]),
         ];
-        if self.written.is_multiple_of(self.stride) || r.event.is_some() {
+        let keep = if r.event.is_some() {
+            self.collisions.is_multiple_of(self.collision_stride)
+        } else {
+            (self.written - self.collisions).is_multiple_of(self.stride)
+        };
+        self.written += 1;
+        self.collisions += usize::from(r.event.is_some());
+        if keep {
             self.kept.push(r);
         }
-        self.written += 1;
         if self.kept.len() > 2 * PLOT_ROWS {
-            // Thin to every other row, keeping collisions.
-            let mut k = 0;
-            self.kept.retain(|r| {
-                k += 1;
-                k % 2 == 1 || r.event.is_some()
-            });
-            self.stride *= 2;
+            self.thin();
         }
         Ok(())
+    }
+
+    /// Halves the rows kept for the plot: every other row of a state, and
+    /// every other collision once collisions are more than a quarter of the
+    /// budget (before that, every collision stays marked). Either way at
+    /// most about 1.25 × [`PLOT_ROWS`] rows remain, so thinning happens
+    /// once in thousands of rows, and the rows kept of each kind stay
+    /// evenly spread over the run.
+    fn thin(&mut self) {
+        let marked = self.kept.iter().filter(|r| r.event.is_some()).count();
+        let thin_collisions = marked > PLOT_ROWS / 2;
+        let (mut states, mut events) = (0usize, 0usize);
+        self.kept.retain(|r| {
+            let seen = if r.event.is_some() {
+                if !thin_collisions {
+                    return true;
+                }
+                &mut events
+            } else {
+                &mut states
+            };
+            *seen += 1;
+            *seen % 2 == 1
+        });
+        self.stride = self.stride.saturating_mul(2);
+        if thin_collisions {
+            self.collision_stride = self.collision_stride.saturating_mul(2);
+        }
     }
 
     pub(super) fn finish(&mut self) -> Result<(), String> {
@@ -125,5 +161,78 @@ impl<const N: usize> Output<N> {
         self.file
             .flush()
             .map_err(|e| format!("cannot write {}: {e}", self.path.display()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use dalembert::models::PendulumWall;
+
+    /// `rows` rows at t = 0, 1, …, a collision wherever `collision(t)`.
+    fn pushed(name: &str, rows: usize, collision: impl Fn(usize) -> bool) -> Output<2> {
+        let path = std::env::temp_dir().join(format!("dalembert-output-{name}.csv"));
+        let mut out = Output::create(&PendulumWall::default(), &path, 0.0).unwrap();
+        for t in 0..rows {
+            out.push(Row {
+                t: t as f64,
+                q: [0.0; 2],
+                v: [0.0; 2],
+                energy: 0.0,
+                residual: [0.0; 2],
+                event: collision(t).then(|| "wall".to_string()),
+            })
+            .unwrap();
+            assert!(
+                out.kept.len() <= 2 * PLOT_ROWS,
+                "{} rows kept at t = {t}",
+                out.kept.len()
+            );
+        }
+        out.finish().unwrap();
+        let _ = std::fs::remove_file(&path);
+        out
+    }
+
+    /// A run that is mostly collisions (each written before and after, as
+    /// a bouncing ball's): the plot's rows stay within the budget, and both
+    /// kinds stay spread over the whole run. Keeping every collision
+    /// regardless let them fill the budget, and every later row then
+    /// rescanned them all.
+    #[test]
+    fn collisions_are_thinned_when_they_fill_the_plot() {
+        let rows = 40_000;
+        let out = pushed("bounces", rows, |t| t % 2 == 0);
+        assert_eq!((out.written, out.collisions), (rows, rows / 2));
+        for marked in [true, false] {
+            let times: Vec<f64> = (out.kept.iter())
+                .filter(|r| r.event.is_some() == marked)
+                .map(|r| r.t)
+                .collect();
+            assert!(times.len() >= PLOT_ROWS / 4, "{} rows", times.len());
+            // Evenly spread: no gap longer than twice the mean one.
+            let mean = rows as f64 / times.len() as f64;
+            for pair in times.windows(2) {
+                assert!(pair[1] - pair[0] <= 2.0 * mean, "{pair:?}, mean gap {mean}");
+            }
+            assert!(times[0] < mean && times[times.len() - 1] > rows as f64 - 2.0 * mean);
+        }
+    }
+
+    /// A few collisions in a long run: every one stays marked.
+    #[test]
+    fn a_few_collisions_all_stay() {
+        let out = pushed("rare", 50_000, |t| t % 5_000 == 4_999);
+        let marked: Vec<f64> = out
+            .kept
+            .iter()
+            .filter(|r| r.event.is_some())
+            .map(|r| r.t)
+            .collect();
+        assert_eq!(
+            marked,
+            (1..=10).map(|k| (5_000 * k - 1) as f64).collect::<Vec<_>>()
+        );
+        assert!(out.kept.len() >= PLOT_ROWS);
     }
 }
