@@ -139,13 +139,10 @@ impl<const N: usize> Output<N> {
         let thin_collisions = marked > PLOT_ROWS / 2;
         let (mut states, mut events) = (0usize, 0usize);
         self.kept.retain(|r| {
-            let seen = if r.event.is_some() {
-                if !thin_collisions {
-                    return true;
-                }
-                &mut events
-            } else {
-                &mut states
+            let seen = match (&r.event, thin_collisions) {
+                (None, _) => &mut states,
+                (Some(_), true) => &mut events,
+                (Some(_), false) => return true,
             };
             *seen += 1;
             *seen % 2 == 1
