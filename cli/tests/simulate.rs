@@ -175,6 +175,48 @@ fn initial_values_follow_the_parameters_set() {
     assert_eq!(z, 2.0);
 }
 
+/// A velocity `--set` off the constraints is projected onto ker A, and the
+/// first row is that projected state with its own residual: at θ = 0.5 the
+/// rolling ball's file velocity has A q̇ = −0.26, its projection none.
+#[test]
+fn the_first_row_is_the_projected_start() {
+    let dir = scratch("simulate-projected");
+    let out = dir.to_str().unwrap();
+    let (ok, stdout, stderr) = dalembert(&[
+        "simulate",
+        "ball_wall_euler",
+        "--set",
+        "theta=0.5",
+        "--t-end",
+        "0.1",
+        "--out",
+        out,
+    ]);
+    assert!(ok, "{stdout}\n{stderr}");
+    assert!(stderr.contains("not admissible"), "{stderr}");
+    let csv = std::fs::read_to_string(dir.join("ball_wall_euler.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let column = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let first: Vec<&str> = csv.lines().nth(1).unwrap().split(',').collect();
+    let value = |name: &str| first[column(name)].parse::<f64>().unwrap();
+    // x' = r ω_y with ω_y = −ψ' sin θ at φ = 0 (r = 1/2), and y' = −r ω_x = 0.
+    let (x_dot, psi_dot) = (value("x_dot"), value("psi_dot"));
+    assert!(
+        (x_dot + 0.5 * psi_dot * 0.5f64.sin()).abs() < 1e-12,
+        "{first:?}"
+    );
+    assert!(value("residual_velocity") < 1e-12, "{first:?}");
+    assert!(stdout.contains("|A q̇| = "), "{stdout}");
+    let worst: f64 = stdout
+        .split("|A q̇| = ")
+        .nth(1)
+        .and_then(|s| s.split(',').next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(worst < 1e-10, "{stdout}");
+}
+
 #[test]
 fn refuses_clearly() {
     let (ok, _, stderr) = dalembert(&["simulate", "ball_wall"]);

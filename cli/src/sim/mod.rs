@@ -347,11 +347,10 @@ fn start<M: Surfaces<N>, const N: usize>(
             v[i] = *value;
         }
     }
-    let start_residual = residual(&model, &q, &v);
-    if start_residual.position > 1e-8 {
+    let position = residual(&model, &q, &v).position;
+    if position > 1e-8 {
         return Err(format!(
-            "the initial coordinates violate the holonomic constraints (|h(q)| = {:e}): set them on the constraint manifold",
-            start_residual.position
+            "the initial coordinates violate the holonomic constraints (|h(q)| = {position:e}): set them on the constraint manifold"
         ));
     }
     let projected = admissible(&model, &q, &v).map_err(|e| format!("initial velocity: {e:?}"))?;
@@ -360,6 +359,9 @@ fn start<M: Surfaces<N>, const N: usize>(
             "note: the initial velocity {v:?} is not admissible (A q̇ ≠ 0); using its G-orthogonal projection onto ker A, {projected:?}"
         );
     }
+    // The residuals of the state the run starts from (its first row), not
+    // of the velocity given before the projection.
+    let start_residual = residual(&model, &q, &projected);
     let start = State {
         t: 0.0,
         q,
