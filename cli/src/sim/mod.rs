@@ -58,9 +58,9 @@ pub struct SimulateArgs {
     /// Absolute tolerance of the adaptive method.
     #[arg(long, default_value_t = 1e-12)]
     pub atol: f64,
-    /// Tolerance of Taylor's method, in (0, 1): absolute where the state's
-    /// largest component is below 1 in size, relative above (default: the
-    /// unit roundoff of f64, 2^-53).
+    /// Tolerance of Taylor's method, from 1e-26 to below 1: absolute where
+    /// the state's largest component is below 1 in size, relative above
+    /// (default: the unit roundoff of f64, 2^-53).
     #[arg(long)]
     pub tolerance: Option<f64>,
     /// A fixed order for Taylor's method (2 to 31; default: the one that
@@ -245,9 +245,12 @@ fn checked_spacing(args: &SimulateArgs) -> Result<f64, String> {
         }
         Method::Taylor => {
             if let Some(tol) = args.tolerance
-                && !(tol > 0.0 && tol < 1.0)
+                && !(Taylor::MIN_TOLERANCE..1.0).contains(&tol)
             {
-                return Err(format!("--tolerance must be in (0, 1), not {tol:?}"));
+                return Err(format!(
+                    "--tolerance must be from {:e} (the order it asks for is then {MAX_ORDER}) to below 1, not {tol:?}",
+                    Taylor::MIN_TOLERANCE
+                ));
             }
             if let Some(p) = args.order
                 && !(2..=MAX_ORDER).contains(&p)

@@ -181,7 +181,10 @@ pub enum SimError<W> {
         /// The step.
         step: f64,
     },
-    /// A setting is out of range (a non-positive step or tolerance).
+    /// A setting is out of range: a step or tolerance not positive and
+    /// finite, a Taylor tolerance or fixed order outside
+    /// [`super::Taylor::valid`]'s ranges, a grazing or simultaneity
+    /// threshold out of range.
     BadSettings,
     /// Taylor's method was asked for, but the model has no Taylor series
     /// of its motion or of a wall's f (generated models with coordinates
@@ -242,7 +245,10 @@ impl<W: core::fmt::Debug> core::fmt::Display for SimError<W> {
             SimError::StepTooSmall { t, step } => {
                 write!(f, "at t = {t}: the step size fell to {step:e}")
             }
-            SimError::BadSettings => write!(f, "a step or tolerance is not positive and finite"),
+            SimError::BadSettings => write!(
+                f,
+                "a setting is out of range (a step or tolerance not positive and finite, or a Taylor tolerance or order outside its range)"
+            ),
             SimError::NoSeries => write!(
                 f,
                 "Taylor's method needs the model's Taylor series (Dynamics::taylor_series, Surfaces::surface_series), which this model does not have"

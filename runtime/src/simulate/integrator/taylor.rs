@@ -21,7 +21,8 @@ const STEP_OVERHEAD: f64 = 1000.0;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Taylor {
     /// The tolerance, absolute for components below 1 and relative above
-    /// (Jorba & Zou's ε; the default is the unit roundoff of f64).
+    /// (Jorba & Zou's ε; the default is the unit roundoff of f64), in
+    /// [[`Taylor::MIN_TOLERANCE`], 1).
     pub tolerance: f64,
     /// A fixed order (2 to [`MAX_ORDER`]) instead of the one the tolerance
     /// asks for. The step is then the last two terms below the tolerance
@@ -45,9 +46,18 @@ impl Default for Taylor {
 }
 
 impl Taylor {
-    /// Whether the settings are usable.
+    /// The smallest tolerance: 10⁻²⁶, whose order ⌈−½ ln ε + 1⌉ (Jorba &
+    /// Zou, eq. 3.8) is [`MAX_ORDER`] (that order covers ε down to
+    /// e⁻⁶⁰ ≈ 8.8e-27). Below it no order the series can reach would keep
+    /// the step near ρ/e²: the steps would shrink like ε^(1/MAX_ORDER), to
+    /// ρ·10⁻¹⁰ at ε = 10⁻³⁰⁰, and a run would never end.
+    pub const MIN_TOLERANCE: f64 = 1e-26;
+
+    /// Whether the settings are usable: the tolerance in
+    /// [[`Taylor::MIN_TOLERANCE`], 1), the largest step positive, a fixed
+    /// order from 2 to [`MAX_ORDER`].
     pub fn valid(&self) -> bool {
-        self.tolerance > 0.0
+        self.tolerance >= Self::MIN_TOLERANCE
             && self.tolerance < 1.0
             && self.max_step > 0.0
             && self
@@ -244,6 +254,19 @@ mod tests {
         };
         assert_eq!((fixed.order(), fixed.low_order()), (28, 14));
         assert!(fixed.valid());
+        // The smallest tolerance asks for the highest order; a smaller one
+        // (or none, or NaN) is refused.
+        let finest = Taylor {
+            tolerance: Taylor::MIN_TOLERANCE,
+            ..t
+        };
+        assert!(finest.valid());
+        assert!(-0.5 * libm::log(Taylor::MIN_TOLERANCE) + 1.0 <= MAX_ORDER as f64);
+        assert_eq!(finest.order(), MAX_ORDER);
+        for tolerance in [Taylor::MIN_TOLERANCE / 2.0, 1e-300, 0.0, 1.0, f64::NAN] {
+            let bad = Taylor { tolerance, ..t };
+            assert!(!bad.valid(), "tolerance {tolerance:e}");
+        }
         for p in [0, 1, MAX_ORDER + 1] {
             let bad = Taylor {
                 fixed_order: Some(p),
