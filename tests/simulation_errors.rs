@@ -1,11 +1,12 @@
 //! The hybrid simulator's contacts and states that must be reported
 //! rather than resolved, each as its typed error: two walls met at once, a
 //! wall met at a grazing speed, and bad starts (non-finite, beyond a wall,
-//! a singular mass matrix, a velocity off the constraints, a bad setting).
+//! a singular mass matrix, a velocity off the constraints, a bad setting,
+//! steps that could not end a run).
 
 use dalembert::models::{BallBounce, BallWallEuler, MassesOnLine};
 use dalembert::runtime::dynamics::DynamicsError;
-use dalembert::runtime::simulate::{Integrator, Rk4, Settings, SimError, Simulator, State};
+use dalembert::runtime::simulate::{Integrator, Rk4, Settings, SimError, Simulator, State, Taylor};
 
 #[test]
 fn simultaneous_contacts_are_reported() {
@@ -112,4 +113,43 @@ fn bad_states_are_typed_errors() {
         ),
         Err(SimError::BadSettings)
     ));
+}
+
+/// Taylor's settings that could not finish a run are errors, not endless
+/// runs: a tolerance below [`Taylor::MIN_TOLERANCE`] is refused at the
+/// start, and a step of a few ulps of t (at order 2 the step is about
+/// ε/‖q̇‖, since its last two terms are q̇ and q̈) is `StepTooSmall`, as
+/// with the Runge–Kutta methods. Before, both stepped on for ever.
+#[test]
+fn taylor_steps_that_cannot_end_a_run_are_errors() {
+    let ball = BallBounce::default();
+    let (q, v) = ball.initial_state();
+    let start = State { t: 0.0, q, v };
+    let with = |taylor: Taylor| Settings {
+        integrator: Integrator::Taylor(taylor),
+        ..Settings::default()
+    };
+    let tiny = with(Taylor {
+        tolerance: 1e-300,
+        ..Taylor::default()
+    });
+    assert!(matches!(
+        Simulator::new(&ball, start, tiny),
+        Err(SimError::BadSettings)
+    ));
+    let order_2 = with(Taylor {
+        fixed_order: Some(2),
+        ..Taylor::default()
+    });
+    let mut sim = Simulator::new(&ball, start, order_2).unwrap();
+    match sim.step(1.0) {
+        Err(SimError::StepTooSmall { t, step }) => {
+            assert_eq!(t, 0.0);
+            assert!(step > 0.0 && step < 1e-15, "{step:e}");
+        }
+        other => panic!("expected StepTooSmall, got {other:?}"),
+    }
+    // The order the tolerance asks for steps on.
+    let mut sim = Simulator::new(&ball, start, with(Taylor::default())).unwrap();
+    assert!(sim.step(1.0).unwrap().state.t > 0.1);
 }

@@ -8,7 +8,7 @@
 use super::dense_output::LastStep;
 use super::integrator::Plan;
 use super::phase::Phase;
-use super::thresholds::{SERIES_ROOT_ITERATIONS, SERIES_SAMPLES};
+use super::thresholds::{SERIES_ROOT_ITERATIONS, SERIES_SAMPLES, SMALLEST_STEP_ULPS};
 use super::{SimError, Simulator, State, Step};
 use crate::Surfaces;
 use crate::dynamics::DynamicsError;
@@ -70,6 +70,12 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             }
         }
         let h = self.series(method, method.order, left)?;
+        // The rule the Runge–Kutta steps keep: a step of a few ulps of t that
+        // does not end the run would never end it (a fixed order far below
+        // the tolerance's steps by about ε/‖q̇‖ at order 2).
+        if h <= SMALLEST_STEP_ULPS * f64::EPSILON * t0.abs().max(1.0) && h < left {
+            return Err(SimError::StepTooSmall { t: t0, step: h });
+        }
         let found = self.first_collision(h)?;
         if tried {
             let reach = found.map_or(h, |(_, tau)| tau);
