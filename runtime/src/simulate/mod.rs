@@ -183,7 +183,7 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
             Engine::Taylor(t) => {
                 series::offered(model, &start)?;
                 *t = t.fitted(model.series_work(), N, model.walls().len());
-                (f64::INFINITY, t.low_order)
+                (f64::INFINITY, Taylor::FIRST_TRIAL_ORDER)
             }
         };
         Ok(Self {

@@ -41,18 +41,20 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     /// order, already reaches a collision or the end of the run, no order
     /// could step further, and the step is taken on it. Otherwise the
     /// series is computed again to the full order, and the lower order is
-    /// raised (from [`Taylor::low_order`] up to the full order, where the
-    /// trials stop) to the lowest order whose own step, read off the same
-    /// coefficients ([`Plan::step_at`]), reaches as far as the full one
-    /// went: to the wall it meets at τ, else to the end of its step. So
-    /// each run learns, in a trial or two, the lowest order its flights
-    /// need so far, and a motion whose steps the radius of convergence
-    /// bounds (where no lower order steps as far) wastes one trial. A
-    /// flight in uniform gravity is the case in point: its motion is nearly
-    /// polynomial, so a lower order reaches the floor at a fraction of the
-    /// cost, and the cost of a series grows as the square of its order.
+    /// raised (from [`Taylor::FIRST_TRIAL_ORDER`] up to the full order,
+    /// where the trials stop) to the lowest order whose own step, read off
+    /// the same coefficients ([`Plan::step_at`]), reaches as far as the full
+    /// one went: to the wall it meets at τ, else to the end of its step. So
+    /// each run learns from its first flight the lowest order its flights
+    /// need, and again, in one trial, each time a flight needs more; a
+    /// motion whose steps the radius of convergence bounds (where no lower
+    /// order steps as far) wastes one trial. A flight in uniform gravity is
+    /// the case in point: its motion is nearly polynomial, so a lower order
+    /// reaches the floor at a fraction of the cost (a parabola's at order
+    /// 4, where its last two terms vanish), and the cost of a series grows
+    /// as the square of its order.
     ///
-    /// [`Taylor::low_order`]: super::Taylor::low_order
+    /// [`Taylor::FIRST_TRIAL_ORDER`]: super::Taylor::FIRST_TRIAL_ORDER
     pub(super) fn series_step(
         &mut self,
         method: &Plan,

@@ -103,8 +103,8 @@ pub struct Stats {
     /// Evaluations of the equations of motion (with Taylor's method: series
     /// computed, the lower-order trials included).
     pub evaluations: u64,
-    /// Steps of Taylor's method taken on a series of lower order than the
-    /// tolerance's (see [`super::Taylor::low_order`]).
+    /// Steps of Taylor's method taken on a lower-order trial's series,
+    /// below the full order (see [`super::Taylor::FIRST_TRIAL_ORDER`]).
     pub low_order_steps: u64,
     /// Taylor's method: the sum of the orders of every series computed
     /// (zero with the other methods). Over the series computed

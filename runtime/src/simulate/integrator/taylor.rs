@@ -121,14 +121,14 @@ impl Taylor {
         best.1
     }
 
-    /// The lower order tried first where a step is likely to end at a wall
-    /// or at the end of the run anyway (see [`crate::simulate`]'s Taylor
-    /// steps): half the order, at least 2. A convolution costs about k
-    /// multiply-adds at order k, so the series to p/2 costs about a quarter
-    /// of the series to p.
-    pub fn low_order(&self) -> usize {
-        (self.order() / 2).max(2)
-    }
+    /// The order of the first lower-order trial of a run (see
+    /// [`crate::simulate`]'s Taylor steps), the lowest there is: a trial
+    /// that falls short is followed by the full series, whose coefficients
+    /// tell the lowest order that would have stepped as far, so the trials
+    /// need no guess of their own. At order 2 the step is about ε/‖q̇‖ (its
+    /// last two terms are q̇ and q̈), so the first trial of a moving state
+    /// falls short, at the cost of a series to order 2.
+    pub const FIRST_TRIAL_ORDER: usize = 2;
 
     /// The step for the series `s` of order p, the shorter of Jorba & Zou's
     /// two estimates (§3.2): the last two terms below the tolerance,
@@ -137,7 +137,7 @@ impl Taylor {
     /// (max(1, ‖x₀‖∞)/‖xⱼ‖∞)^(1/j)), both with the safety factor
     /// exp(−0.7/(p − 1)) heyoka uses; the norms are over every coordinate
     /// and velocity. At the order the tolerance asks for the asymptotic step
-    /// is the shorter; at a lower order (`low_order`) the first one is. The
+    /// is the shorter; at a lower order (a trial's) the first one is. The
     /// asymptotic step is Jorba & Zou's for the order the tolerance asks
     /// for, so with a [`fixed_order`](Self::fixed_order) only the first
     /// estimate bounds the step. A series whose last two orders vanish (a
@@ -151,9 +151,8 @@ impl Taylor {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Plan {
     pub method: Taylor,
-    /// [`Taylor::order`] and [`Taylor::low_order`].
+    /// [`Taylor::order`], or [`Taylor::order_for`] the model.
     pub order: usize,
-    pub low_order: usize,
     log_tolerance: f64,
     /// ln of the asymptotic step's factor, e⁻², or +∞ where only the
     /// truncation bounds the step (a fixed order).
@@ -166,7 +165,6 @@ impl Plan {
         Self {
             method,
             order: method.order(),
-            low_order: method.low_order(),
             log_tolerance: libm::log(method.tolerance),
             log_asymptotic: match method.fixed_order {
                 Some(_) => f64::INFINITY,
@@ -177,7 +175,7 @@ impl Plan {
 
     /// At the order [`Taylor::order_for`] picks for a model; above the
     /// tolerance's order, only the last two terms bound the step, as at a
-    /// fixed order. The lower order tried first stays the tolerance's.
+    /// fixed order.
     pub fn fitted(self, work: Option<SeriesWork>, n: usize, walls: usize) -> Self {
         let order = self.method.order_for(work, n, walls);
         Self {
@@ -252,7 +250,7 @@ mod tests {
             fixed_order: Some(28),
             ..loose
         };
-        assert_eq!((fixed.order(), fixed.low_order()), (28, 14));
+        assert_eq!(fixed.order(), 28);
         assert!(fixed.valid());
         // The smallest tolerance asks for the highest order; a smaller one
         // (or none, or NaN) is refused.
@@ -321,9 +319,9 @@ mod tests {
         let p = loose.order_for(Some(work(12, 23)), 5, 1);
         assert!(p > loose.order() && p < 26, "{p}");
         // The plan above the tolerance's order steps by the truncation
-        // estimate alone, and keeps the tolerance's lower order.
+        // estimate alone.
         let plan = Plan::new(t).fitted(Some(work(11, 34)), 5, 1);
-        assert_eq!((plan.order, plan.low_order), (26, 10));
+        assert_eq!(plan.order, 26);
         assert_eq!(plan.log_asymptotic, f64::INFINITY);
         assert_eq!(Plan::new(t).fitted(None, 5, 1), Plan::new(t));
     }
@@ -344,9 +342,8 @@ mod tests {
         let e2 = core::f64::consts::E * core::f64::consts::E;
         let want = rho / e2 * libm::exp(-0.7 / (p - 1.0));
         assert!(libm::fabs(h - want) <= 1e-15 * want);
-        // At the lower order the last two terms bound the step:
+        // At a lower order the last two terms bound the step:
         // h = min over j ∈ {7, 8} of (ε/‖x_j‖)^(1/j), shorter than ρ/e².
-        assert_eq!(t.low_order(), 10);
         s.order = 8;
         let eps = t.tolerance;
         let h8 = t.step(&s);
