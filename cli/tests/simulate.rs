@@ -402,6 +402,20 @@ fn taylor_integrator_from_the_command_line() {
                 "taylor-28" => assert_eq!(order, Some(28), "{stdout}"),
                 _ => assert_eq!(order, None, "{stdout}"),
             }
+            // And the mean order of the series computed, at most the full
+            // one (the lower-order trials bring it down).
+            let mean = stdout.split("mean order ").nth(1).map(|rest| {
+                let number: String = rest
+                    .chars()
+                    .take_while(|c| c.is_ascii_digit() || *c == '.')
+                    .collect();
+                number.parse::<f64>().unwrap()
+            });
+            match (order, mean) {
+                (Some(p), Some(m)) => assert!(m >= 2.0 && m <= p as f64, "{stdout}"),
+                (None, None) => {}
+                _ => panic!("{stdout}"),
+            }
             let csv = std::fs::read_to_string(dir.join(format!("{name}.csv"))).unwrap();
             let hits = csv.lines().skip(1).filter(|l| !l.ends_with(',')).count();
             collisions.push(hits);

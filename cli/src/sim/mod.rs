@@ -483,9 +483,19 @@ fn summary<M: Surfaces<N>, const N: usize>(
     secs: f64,
 ) {
     let stats = sim.stats();
-    let order = sim
-        .taylor_order()
-        .map_or(String::new(), |p| format!(" at order {p}"));
+    // Taylor's full order, and what the steps used: most flights end on a
+    // lower-order trial's series, so the full order alone would overstate
+    // the work (`Stats::series_orders` over the series computed, which are
+    // the evaluations less the q̈ at the start).
+    let order = sim.taylor_order().map_or(String::new(), |p| {
+        let series = stats.evaluations.saturating_sub(1).max(1);
+        format!(
+            " at order {p} (series of mean order {:.1}; {} of {} steps on a lower-order trial)",
+            stats.series_orders as f64 / series as f64,
+            stats.low_order_steps,
+            stats.steps
+        )
+    });
     println!(
         "{}: t = 0 → {} with {:?}{order}",
         model.name(),
