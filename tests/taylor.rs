@@ -148,8 +148,8 @@ fn nonholonomic_pendulum_with_taylor() {
     let (stats, bounced) = bounces_with_taylor(&ball, bounce::after_bounce(&ball), p.r, p.g, 1e-13);
     // Each flight is taken on the series of a lower order (nearly
     // polynomial: even that reaches the floor), but for the few in which
-    // the run learns the order it needs, and no higher than that.
-    assert!(stats.low_order_steps + 12 >= stats.steps, "{stats:?}");
+    // the run learns the order it needs (one per order learnt), and no
+    // higher than that.
     assert_orders_learnt(&ball, &stats, &bounced);
 }
 
