@@ -478,6 +478,28 @@ fn taylor_integrator_from_the_command_line() {
         ]);
         assert!(!ok && stderr.contains(flag), "{flag} {value}: {stderr}");
     }
+    // A fixed order below the tolerance's is run, with a note saying what
+    // it costs; above it, no note.
+    for (order, noted) in [("10", true), ("28", false)] {
+        let (ok, _, stderr) = dalembert(&[
+            "simulate",
+            "ball_bounce",
+            "--integrator",
+            "taylor",
+            "--order",
+            order,
+            "--t-end",
+            "0.5",
+            "--out",
+            scratch("simulate-order-note").to_str().unwrap(),
+        ]);
+        assert!(ok, "{stderr}");
+        assert_eq!(
+            stderr.contains("below the order the tolerance asks for (20)"),
+            noted,
+            "--order {order}: {stderr}"
+        );
+    }
     // Taylor's settings with another method: refused, not ignored.
     for (flag, value) in [("--tolerance", "1e-12"), ("--order", "28")] {
         let (ok, _, stderr) = dalembert(&["simulate", "ball_bounce", flag, value]);

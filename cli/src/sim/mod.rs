@@ -257,6 +257,22 @@ fn checked_spacing(args: &SimulateArgs) -> Result<f64, String> {
             {
                 return Err(format!("--order must be from 2 to {MAX_ORDER}, not {p}"));
             }
+            // Below the tolerance's own order the steps shrink fast (the
+            // last two terms must fall below the tolerance): allowed, but
+            // said, since a looser tolerance is what lowers the order well.
+            let asked = settings(args).integrator;
+            if let (Some(p), Integrator::Taylor(t)) = (args.order, asked) {
+                let own = Taylor {
+                    fixed_order: None,
+                    ..t
+                }
+                .order();
+                if p < own {
+                    eprintln!(
+                        "note: --order {p} is below the order the tolerance asks for ({own}): the steps will be far shorter than at {own} (at order 2, about the tolerance over the speed); a looser --tolerance gives a lower order"
+                    );
+                }
+            }
         }
     }
     Ok(every)
