@@ -233,6 +233,13 @@ fn refuses_clearly() {
     );
     let (ok, _, stderr) = dalembert(&["simulate", "pendulum_wall", "--set", "x=0.9"]);
     assert!(!ok && stderr.contains("holonomic"), "{stderr}");
+    // A singular G where the start is projected onto ker A: said in words,
+    // not as the error's Rust name.
+    let (ok, _, stderr) = dalembert(&["simulate", "ball_wall_quaternion", "--set", "J=0"]);
+    assert!(
+        !ok && stderr.contains("G(q) is not positive definite") && !stderr.contains("Definite"),
+        "{stderr}"
+    );
 }
 
 /// A model file of a user's, never compiled: a puck on a round table (its

@@ -122,6 +122,20 @@ pub enum ProjectorError {
     DependentRows,
 }
 
+impl core::fmt::Display for ProjectorError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            ProjectorError::MassMatrixNotPositiveDefinite => {
+                "the mass matrix G(q) is not positive definite (a zero or negative mass or moment of inertia, or a coordinate singularity?)"
+            }
+            ProjectorError::NonFinite => "an entry of G(q) or of the rows is not finite",
+            ProjectorError::DependentRows => {
+                "the constraint rows are dependent here (B G⁻¹ Bᵀ is singular)"
+            }
+        })
+    }
+}
+
 /// P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B from G and the rows of B, without allocation.
 ///
 /// With G = L Lᵀ (Cholesky) and w = Lᵀ v the metric becomes Euclidean and

@@ -372,7 +372,9 @@ fn start<M: Surfaces<N>, const N: usize>(
             "the initial coordinates violate the holonomic constraints (|h(q)| = {position:e}): set them on the constraint manifold"
         ));
     }
-    let projected = admissible(&model, &q, &v).map_err(|e| format!("initial velocity: {e:?}"))?;
+    let projected = admissible(&model, &q, &v).map_err(|e| {
+        format!("the initial velocity cannot be projected onto the constraints (A q̇ = 0): {e}")
+    })?;
     if projected.iter().zip(&v).any(|(a, b)| (a - b).abs() > 1e-12) {
         eprintln!(
             "note: the initial velocity {v:?} is not admissible (A q̇ ≠ 0); using its G-orthogonal projection onto ker A, {projected:?}"

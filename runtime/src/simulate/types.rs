@@ -239,7 +239,7 @@ impl<W: core::fmt::Debug> core::fmt::Display for SimError<W> {
             SimError::Projection { t, error } => {
                 write!(
                     f,
-                    "at t = {t}: projection onto the constraints failed ({error:?})"
+                    "at t = {t}: projection onto the constraints failed: {error}"
                 )
             }
             SimError::StepTooSmall { t, step } => {
