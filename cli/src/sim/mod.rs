@@ -260,8 +260,7 @@ fn checked_spacing(args: &SimulateArgs) -> Result<f64, String> {
             // Below the tolerance's own order the steps shrink fast (the
             // last two terms must fall below the tolerance): allowed, but
             // said, since a looser tolerance is what lowers the order well.
-            let asked = settings(args).integrator;
-            if let (Some(p), Integrator::Taylor(t)) = (args.order, asked) {
+            if let (Some(p), Integrator::Taylor(t)) = (args.order, settings(args).integrator) {
                 let own = Taylor {
                     fixed_order: None,
                     ..t
