@@ -4,7 +4,7 @@
 
 use super::integrator::{Method, RungeKutta, Trial};
 use super::phase::Phase;
-use super::thresholds::{FAILED_STEP_RETRIES, FAILED_STEP_SHRINK, SMALLEST_STEP_ULPS};
+use super::thresholds::{FAILED_STEP_RETRIES, FAILED_STEP_SHRINK, step_too_small};
 use super::{SimError, Simulator, derivative};
 use crate::Surfaces;
 
@@ -50,7 +50,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         let mut failures = 0;
         loop {
             let h = self.proposal.min(t_end - t0).min(limit);
-            if h <= SMALLEST_STEP_ULPS * f64::EPSILON * t0.abs().max(1.0) && t0 + h < t_end {
+            if step_too_small(h, t0) && t0 + h < t_end {
                 return Err(SimError::StepTooSmall { t: t0, step: h });
             }
             if !method.adaptive() {

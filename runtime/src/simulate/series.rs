@@ -8,7 +8,7 @@
 use super::dense_output::LastStep;
 use super::integrator::Plan;
 use super::phase::Phase;
-use super::thresholds::{SERIES_ROOT_ITERATIONS, SERIES_SAMPLES, SMALLEST_STEP_ULPS};
+use super::thresholds::{SERIES_ROOT_ITERATIONS, SERIES_SAMPLES, step_too_small};
 use super::{SimError, Simulator, State, Step};
 use crate::Surfaces;
 use crate::dynamics::DynamicsError;
@@ -72,10 +72,9 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             }
         }
         let h = self.series(method, method.order, left)?;
-        // The rule the Runge–Kutta steps keep: a step of a few ulps of t that
-        // does not end the run would never end it (a fixed order far below
-        // the tolerance's steps by about ε/‖q̇‖ at order 2).
-        if h <= SMALLEST_STEP_ULPS * f64::EPSILON * t0.abs().max(1.0) && h < left {
+        // The Runge–Kutta steps' rule (a fixed order far below the
+        // tolerance's steps by about ε/‖q̇‖ at order 2).
+        if step_too_small(h, t0) && h < left {
             return Err(SimError::StepTooSmall { t: t0, step: h });
         }
         let found = self.first_collision(h)?;

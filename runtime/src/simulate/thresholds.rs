@@ -32,6 +32,13 @@ pub const SHORTEST_AIM_ULPS: f64 = 16.0;
 /// [`super::SimError::StepTooSmall`].
 pub const SMALLEST_STEP_ULPS: f64 = 4.0;
 
+/// Whether a step of length h from t is within [`SMALLEST_STEP_ULPS`] ulps
+/// of t: one that does not end the run would never end it. Every method's
+/// steps are judged by it.
+pub(super) fn step_too_small(h: f64, t: f64) -> bool {
+    h <= SMALLEST_STEP_ULPS * f64::EPSILON * t.abs().max(1.0)
+}
+
 /// An adaptive step whose stages meet a singular or non-finite state is
 /// shrunk by [`FAILED_STEP_SHRINK`] at most this many times before the
 /// error is reported.
