@@ -260,22 +260,25 @@ pub fn recip_finish(c: &Coefficients, a: &Coefficients, h: f64, k: usize) -> f64
 
 /// Coefficient k ≥ 1 of c = a/b from the [`history`] h of b with c:
 /// cₖ = (aₖ − bₖc₀ − h)/b₀, one convolution where 1/b then a·(1/b) take
-/// two.
+/// two. The division is by b₀, known from order 0 on: as a product with
+/// 1/b₀ it is off the chain from one order's coefficients to the next
+/// (a division's latency is several multiplications'), whatever the
+/// compiler keeps of 1/b₀ from one order to the next.
 #[inline(always)]
 pub fn div_finish(c: &Coefficients, a: &Coefficients, b: &Coefficients, h: f64, k: usize) -> f64 {
-    (a[k] - b[k] * c[0] - h) / b[0]
+    (a[k] - b[k] * c[0] - h) * (1.0 / b[0])
 }
 
 /// Coefficient k ≥ 1 of c = √a from the [`history`] h of c with itself.
 #[inline(always)]
 pub fn sqrt_finish(c: &Coefficients, a: &Coefficients, h: f64, k: usize) -> f64 {
-    (a[k] - h) / (2.0 * c[0])
+    (a[k] - h) * (0.5 / c[0])
 }
 
 /// Coefficient k ≥ 1 of c = a^α from its [`power_history`] h.
 #[inline(always)]
 pub fn power_finish(c: &Coefficients, a: &Coefficients, alpha: f64, h: f64, k: usize) -> f64 {
-    (power_weight(alpha, k, 0) * a[k] * c[0] + h) / (k as f64 * a[0])
+    (power_weight(alpha, k, 0) * a[k] * c[0] + h) * (RECIPROCALS[k] / a[0])
 }
 
 /// Coefficient k ≥ 1 of c = eᵃ from the [`weighted_history`] h of a with c.
@@ -288,7 +291,7 @@ pub fn exp_finish(c: &Coefficients, a: &Coefficients, h: f64, k: usize) -> f64 {
 /// a.
 #[inline(always)]
 pub fn log_finish(a: &Coefficients, h: f64, k: usize) -> f64 {
-    (a[k] - h * RECIPROCALS[k]) / a[0]
+    (a[k] - h * RECIPROCALS[k]) * (1.0 / a[0])
 }
 
 /// Coefficient k ≥ 1 of (sin a, cos a) from the [`weighted_history`] of a
