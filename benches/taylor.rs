@@ -120,7 +120,9 @@ fn bounce_run<M: Surfaces<6>>(
                 n += 1;
                 let exact = (4 * n) as f64 / g;
                 dt = dt.max((c.t - exact).abs() / exact);
-                de = de.max((ball.energy(&c.q, &c.v_plus) - e0).abs() / e0);
+                // The step's own report: the energy just after the
+                // collision, (q, v⁺).
+                de = de.max((s.energy - e0).abs() / e0);
             }
             true
         })
