@@ -242,6 +242,25 @@ fn refuses_clearly() {
     );
 }
 
+/// A setting out of range is named with its value as given: a negative
+/// number is read as the flag's value (not as an unknown flag), and a
+/// value far from 1 is written in exponent form.
+#[test]
+fn settings_out_of_range_are_named() {
+    for (flag, value) in [("--t-end", "-1"), ("--atol", "-1e-12"), ("--every", "-0.5")] {
+        let (ok, _, stderr) = dalembert(&["simulate", "puck", flag, value]);
+        assert!(
+            !ok && stderr.contains(&format!("{flag} must be a positive finite number (got -")),
+            "{flag} {value}: {stderr}"
+        );
+    }
+    let (ok, _, stderr) = dalembert(&["simulate", "puck", "--t-end", "0.01", "--every", "1e-300"]);
+    assert!(
+        !ok && stderr.contains("--every 1e-300 would write 1.0e298 rows") && stderr.len() < 200,
+        "{stderr}"
+    );
+}
+
 /// A model file of a user's, never compiled: a puck on a round table (its
 /// rim `sqrt`, its radius a derived parameter) cut by a slanted edge (`tan`
 /// of an angle given with `pi`).

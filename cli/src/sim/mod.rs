@@ -44,30 +44,30 @@ pub struct SimulateArgs {
     #[arg(long_help = models_help())]
     pub model: String,
     /// Simulate from t = 0 to this time.
-    #[arg(long, default_value_t = 5.0)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 5.0)]
     pub t_end: f64,
     /// Integration method.
     #[arg(long, value_enum, default_value_t = Method::DormandPrince)]
     pub integrator: Method,
     /// Step of the fixed-step method.
-    #[arg(long, default_value_t = 1e-3)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1e-3)]
     pub step: f64,
     /// Relative tolerance of the adaptive method.
-    #[arg(long, default_value_t = 1e-10)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1e-10)]
     pub rtol: f64,
     /// Absolute tolerance of the adaptive method.
-    #[arg(long, default_value_t = 1e-12)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1e-12)]
     pub atol: f64,
     /// Tolerance of Taylor's method, from 1e-26 to below 1: absolute where
     /// the state's largest component is below 1 in size, relative above
     /// (default: the unit roundoff of f64, 2^-53).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub tolerance: Option<f64>,
     /// A fixed order for Taylor's method (2 to 31; default: the one that
     /// costs least per unit of time by the model's series work, at least
     /// the tolerance's, 20 at 2^-53). Above the tolerance's order the steps
     /// are longer, where the radius of convergence bounds them.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub order: Option<usize>,
     /// NAME=VALUE for a parameter, a coordinate or a velocity (repeatable);
     /// the rest come from the model file (`[parameters]`, `[initial]`).
@@ -76,7 +76,7 @@ pub struct SimulateArgs {
     /// Time between output rows (default: t_end / 2000). Collisions are
     /// always written, before and after. With Taylor's method the rows come
     /// off the steps' polynomials; the other methods stop a step at each row.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub every: Option<f64>,
     /// Two coordinates to draw as the path, e.g. `x,z` (default: the first two).
     #[arg(long)]
@@ -204,7 +204,9 @@ fn checked_spacing(args: &SimulateArgs) -> Result<f64, String> {
         if x.is_finite() && x > 0.0 {
             Ok(())
         } else {
-            Err(format!("{name} must be a positive finite number (got {x})"))
+            Err(format!(
+                "{name} must be a positive finite number (got {x:?})"
+            ))
         }
     };
     positive("--t-end", args.t_end)?;
@@ -212,7 +214,7 @@ fn checked_spacing(args: &SimulateArgs) -> Result<f64, String> {
     positive("--every", every)?;
     if args.t_end / every > MAX_ROWS {
         return Err(format!(
-            "--t-end {} with --every {every} would write {:.1e} rows; the limit is {MAX_ROWS:.0e}: raise --every",
+            "--t-end {:?} with --every {every:?} would write {:.1e} rows; the limit is {MAX_ROWS:.0e}: raise --every",
             args.t_end,
             args.t_end / every
         ));
@@ -232,7 +234,7 @@ fn checked_spacing(args: &SimulateArgs) -> Result<f64, String> {
             positive("--step", args.step)?;
             if args.t_end / args.step > MAX_STEPS {
                 return Err(format!(
-                    "--t-end {} with --step {} would take {:.1e} steps; the limit is {MAX_STEPS:.0e}",
+                    "--t-end {:?} with --step {:?} would take {:.1e} steps; the limit is {MAX_STEPS:.0e}",
                     args.t_end,
                     args.step,
                     args.t_end / args.step
