@@ -121,6 +121,64 @@ fn a_wrong_reference_entry_is_reported() {
     assert_eq!(positions(&c.collision), vec![(2, 0)]);
 }
 
+/// A reference may be written in any of the model's names: §3.2 with J′ =
+/// J + r²m declared as the model's derived parameter `Jp` and printed as
+/// `Jp`, as the paper does, agrees as the written-out form does (before, Jp
+/// was compared as a free symbol, and every entry and component with J′
+/// differed).
+#[test]
+fn a_reference_in_the_models_derived_parameter_agrees() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("paper-derived-parameter");
+    std::fs::create_dir_all(&dir).unwrap();
+    let model = std::fs::read_to_string(model_file("ball_floor")).unwrap();
+    let j_line = model
+        .lines()
+        .find(|l| l.starts_with("J = "))
+        .expect("ball_floor declares J");
+    let model = model.replacen(
+        j_line,
+        &format!("{j_line}\nJp = {{ value = \"J + r^2*m\", doc = \"J′\" }}"),
+        1,
+    );
+    let file = dir.join("ball_floor.toml");
+    std::fs::write(&file, model).unwrap();
+    let d = derive(&file).unwrap_or_else(|e| panic!("{}", e.render()));
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/reference/ball_floor.toml");
+    let mut r = Reference::load(&path).unwrap();
+    let jp = |e: &String| e.replace("(J + r^2*m)", "Jp");
+    r.prefactor = r.prefactor.as_ref().map(jp);
+    r.collision = r.collision.iter().map(jp).collect();
+    assert!(
+        r.collision.iter().any(|e| e.contains("Jp")),
+        "{:?}",
+        r.collision
+    );
+    let c = r.compare(&d).unwrap();
+    assert_eq!(positions(&c.projector), vec![(2, 2)], "{:#?}", c.projector);
+    assert!(c.collision.is_empty(), "{:#?}", c.collision);
+}
+
+/// A name the model does not declare (here a typo) is an error that names
+/// it and where it is, not an entry that differs from the paper; a P of the
+/// wrong shape says which row.
+#[test]
+fn a_reference_with_a_name_the_model_lacks_is_refused() {
+    let d = derived("ball_floor");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/reference/ball_floor.toml");
+    let r = Reference::load(&path).unwrap();
+    let mut typo = r.clone();
+    typo.collision[2] = "-v33".into();
+    let e = typo.compare(&d).unwrap_err();
+    assert!(
+        e.contains("collision component 3") && e.contains("`v33`") && e.contains("v1, v2, v3"),
+        "{e}"
+    );
+    let mut short = r.clone();
+    short.projector[1].truncate(2);
+    let e = short.compare(&d).unwrap_err();
+    assert!(e.contains("row 2 has 2 entries"), "{e}");
+}
+
 /// §3.2.1: v⁻ = (−v, 0, −u), ω⁻ = (0, rmv/J, 0) maps to v⁺ = −v⁻, ω⁺ = −ω⁻,
 /// exactly, for all m, r, J, u, v.
 #[test]

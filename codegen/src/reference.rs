@@ -78,6 +78,83 @@ impl Reference {
         }
     }
 
+    /// Every expression of the reference, with where it is (1-based).
+    fn expressions(&self) -> Vec<(String, &str)> {
+        let mut out = Vec::new();
+        if let Some(f) = &self.prefactor {
+            out.push(("prefactor".to_string(), f.as_str()));
+        }
+        for (i, row) in self.projector.iter().enumerate() {
+            for (j, e) in row.iter().enumerate() {
+                out.push((format!("P entry ({}, {})", i + 1, j + 1), e.as_str()));
+            }
+        }
+        for (i, e) in self.collision.iter().enumerate() {
+            out.push((format!("collision component {}", i + 1), e.as_str()));
+        }
+        for (name, e) in &self.admissible {
+            out.push((format!("[admissible] `{name}`"), e.as_str()));
+        }
+        out
+    }
+
+    /// That every name the reference uses is one of the model's: a name the
+    /// model does not declare (a typo, or a symbol of the paper's own)
+    /// would be compared as a free symbol and make the entry differ, which
+    /// reads as a disagreement with the paper rather than a mistake in the
+    /// reference.
+    fn check_names(&self, d: &Derivation) -> Result<(), String> {
+        let m = &d.model;
+        let known = |name: &str| {
+            m.params.iter().any(|p| p.name == name)
+                || m.definitions.iter().any(|(n, _)| n == name)
+                || m.coordinates.iter().any(|n| n == name)
+                || m.velocities.iter().any(|n| n == name)
+        };
+        for (place, text) in self.expressions() {
+            let node = crate::ir::expr::parse(text)
+                .map_err(|e| format!("the reference's {place}, `{text}`: {}", e.message))?;
+            let mut unknown = None;
+            node.visit_names(&mut |name, _| {
+                if unknown.is_none() && !known(name) {
+                    unknown = Some(name.to_string());
+                }
+            });
+            if let Some(name) = unknown {
+                let names = |kind: &str, list: Vec<&str>| {
+                    (!list.is_empty()).then(|| format!("{kind} {}", list.join(", ")))
+                };
+                let declared: Vec<String> = [
+                    names(
+                        "parameters",
+                        m.params.iter().map(|p| p.name.as_str()).collect(),
+                    ),
+                    names(
+                        "definitions",
+                        m.definitions.iter().map(|(n, _)| n.as_str()).collect(),
+                    ),
+                    names(
+                        "coordinates",
+                        m.coordinates.iter().map(String::as_str).collect(),
+                    ),
+                    names(
+                        "velocities",
+                        m.velocities.iter().map(String::as_str).collect(),
+                    ),
+                ]
+                .into_iter()
+                .flatten()
+                .collect();
+                return Err(format!(
+                    "the reference's {place}, `{text}`, names `{name}`, which `{}` does not declare ({})",
+                    m.name,
+                    declared.join("; ")
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// Compares with `d`.
     #[allow(clippy::needless_range_loop)] // matrix code reads best with indices
     pub fn compare(&self, d: &Derivation) -> Result<Comparison, String> {
@@ -114,14 +191,47 @@ impl Reference {
             ));
         };
         let n = d.model.velocities.len();
-        if self.projector.len() != n || self.projector.iter().any(|r| r.len() != n) {
-            return Err(format!("the reference P must be {n}×{n}"));
+        if self.projector.len() != n {
+            return Err(format!(
+                "the reference P must be {n}×{n}: it has {} rows",
+                self.projector.len()
+            ));
         }
+        if let Some((i, row)) = self
+            .projector
+            .iter()
+            .enumerate()
+            .find(|(_, r)| r.len() != n)
+        {
+            return Err(format!(
+                "the reference P must be {n}×{n}: its row {} has {} entries",
+                i + 1,
+                row.len()
+            ));
+        }
+        if !self.collision.is_empty() && self.collision.len() != n {
+            return Err(format!(
+                "the reference collision law must have {n} components, not {}",
+                self.collision.len()
+            ));
+        }
+        self.check_names(d)?;
+        // The model's derived parameters and definitions stand for their
+        // expressions on both sides: the derived entries are in the
+        // model's own parameters, coordinates and velocities, and a
+        // reference may be written in any of its names.
+        let definitions: Vec<(String, String)> = d
+            .model
+            .definitions
+            .iter()
+            .map(|(name, e)| (name.clone(), e.text.clone()))
+            .collect();
+        let same = |a: &str, b: &str| symbolic::same_with(a, b, &definitions);
         let mut projector = Vec::new();
         for i in 0..n {
             for j in 0..n {
                 let reference = self.entry(i, j);
-                if !symbolic::same(&reference, &derived_p[i][j])? {
+                if !same(&reference, &derived_p[i][j])? {
                     projector.push(Difference {
                         row: i,
                         col: j,
@@ -133,11 +243,6 @@ impl Reference {
         }
         let mut collision = Vec::new();
         if !self.collision.is_empty() {
-            if self.collision.len() != n {
-                return Err(format!(
-                    "the reference collision law must have {n} components"
-                ));
-            }
             let subs: Vec<(&str, &str)> = self
                 .admissible
                 .iter()
@@ -146,7 +251,7 @@ impl Reference {
             for (i, (r, c)) in self.collision.iter().zip(derived_law).enumerate() {
                 let r_sub = symbolic::substitute(r, &subs)?;
                 let c_sub = symbolic::substitute(c, &subs)?;
-                if !symbolic::same(&r_sub, &c_sub)? {
+                if !same(&r_sub, &c_sub)? {
                     collision.push(Difference {
                         row: i,
                         col: 0,

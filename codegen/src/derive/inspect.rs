@@ -14,16 +14,34 @@ use super::lower::vanishes;
 
 /// `text` as an expression of the model language.
 fn atom(text: &str) -> Result<Atom, String> {
+    atom_with(text, &HashMap::new())
+}
+
+/// `text` as an expression, each name in `definitions` standing for its
+/// expression.
+fn atom_with(text: &str, definitions: &HashMap<String, Atom>) -> Result<Atom, String> {
     let node = crate::ir::expr::parse(text).map_err(|e| format!("`{text}`: {}", e.message))?;
-    build(&node, &HashMap::new()).map_err(|e| format!("`{text}`: {}", e.message))
+    build(&node, definitions).map_err(|e| format!("`{text}`: {}", e.message))
 }
 
 /// Whether two expressions (in the model's names) are equal as rational
 /// functions of the names and the function applications, sin² + cos² = 1
 /// taken into account.
 pub fn same(a: &str, b: &str) -> Result<bool, String> {
+    same_with(a, b, &[])
+}
+
+/// [`same`], where each name in `definitions` (name and expression, each
+/// in terms of the names before it, as a model's derived parameters and
+/// definitions are) stands for its expression on both sides.
+pub fn same_with(a: &str, b: &str, definitions: &[(String, String)]) -> Result<bool, String> {
     crate::lock::acquire()?;
-    Ok(vanishes(&(atom(a)? - atom(b)?)))
+    let mut defs = HashMap::new();
+    for (name, text) in definitions {
+        let value = atom_with(text, &defs)?;
+        defs.insert(name.clone(), value);
+    }
+    Ok(vanishes(&(atom_with(a, &defs)? - atom_with(b, &defs)?)))
 }
 
 /// Evaluates `expr` at the given values.
