@@ -135,10 +135,11 @@ fn same_functions<M: Surfaces<N>, I: Surfaces<N>, const N: usize>(
     );
     // The Taylor series, where the model has them (both or neither).
     let (mut tc, mut ti) = (Series::at(q, v), Series::at(q, v));
-    let has = c.taylor_series(&mut tc, 12);
+    let (mut sc, mut si) = Default::default();
+    let has = c.taylor_series(&mut tc, &mut sc, 12);
     assert_eq!(
         has,
-        i.taylor_series(&mut ti, 12),
+        i.taylor_series(&mut ti, &mut si, 12),
         "{name}: series offered alike"
     );
     if has {
@@ -152,7 +153,10 @@ fn same_functions<M: Surfaces<N>, I: Surfaces<N>, const N: usize>(
     for (&wc, &wi) in c.walls().iter().zip(i.walls()) {
         if has {
             let (mut fc, mut fi) = ([0.0; CAPACITY], [0.0; CAPACITY]);
-            assert!(c.surface_series(wc, &tc, &mut fc) && i.surface_series(wi, &tc, &mut fi));
+            assert!(
+                c.surface_series(wc, &tc, &mut sc, &mut fc)
+                    && i.surface_series(wi, &tc, &mut si, &mut fi)
+            );
             agree(&format!("{name} {} f series", c.wall_name(wc)), &fc, &fi);
         }
         let w = format!("{name} {}", c.wall_name(wc));
@@ -276,7 +280,7 @@ macro_rules! interpreted_test {
             runs_agree::<$ty, $n>(&d, Settings::default());
             let m = <$ty>::with_params(Default::default());
             let mut s = Series::at(&m.initial_coordinates(), &m.initial_velocities());
-            if m.taylor_series(&mut s, 1) {
+            if m.taylor_series(&mut s, &mut Default::default(), 1) {
                 let taylor = Settings {
                     integrator: Integrator::Taylor(Taylor::default()),
                     ..Settings::default()

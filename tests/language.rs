@@ -394,7 +394,14 @@ fn names_the_generated_code_cannot_hold_are_refused() {
         dalembert_codegen::ir::parse(std::path::Path::new("names.toml"), &text)
     };
     for name in [
-        "default", "option", "params", "wall", "self", "some", "result",
+        "default",
+        "option",
+        "params",
+        "wall",
+        "self",
+        "some",
+        "result",
+        "series_scratch",
     ] {
         let e = model(name, &["floor"]).expect_err(name);
         assert!(e.to_string().contains(name), "{e}");

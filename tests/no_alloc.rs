@@ -99,13 +99,14 @@ fn exercise_motion<M: Surfaces<N>, const N: usize>(m: &M) -> f64 {
     }
     let mut series = dalembert::runtime::taylor::Series::at(&q, &v);
     let mut f = [0.0; dalembert::runtime::taylor::CAPACITY];
-    if m.taylor_series(&mut series, 20) {
+    let mut scratch = M::SeriesScratch::default();
+    if m.taylor_series(&mut series, &mut scratch, 20) {
         s += series.q[0][20];
     }
     for &w in m.walls() {
         s += m.surface(w, &q);
         s += m.surface_hessian(w, &q, &v).unwrap_or(0.0);
-        if m.surface_series(w, &series, &mut f) {
+        if m.surface_series(w, &series, &mut scratch, &mut f) {
             s += f[series.order];
         }
     }
@@ -199,12 +200,14 @@ fn interpreted_series_do_not_allocate() {
         q: ball.initial_coordinates(),
         v: ball.initial_velocities(),
     };
+    // The interpreter keeps the room for its intermediate series itself:
+    // the first call sizes it.
     let series = || {
         let mut s = Series::at(&start.q, &start.v);
-        assert!(ball.taylor_series(&mut s, 20));
+        assert!(ball.taylor_series(&mut s, &mut (), 20));
         let mut f = [0.0; CAPACITY];
         for &w in ball.walls() {
-            assert!(ball.surface_series(w, &s, &mut f));
+            assert!(ball.surface_series(w, &s, &mut (), &mut f));
         }
         f[2]
     };

@@ -95,7 +95,7 @@ fn orders_needed<M: Surfaces<6>>(ball: &M, bounced: &[Bounce]) -> Vec<usize> {
         .map(|w| {
             let ((t0, q, v), (t1, _, _)) = (w[0], w[1]);
             let mut s = Series::at(&q, &v);
-            ball.taylor_series(&mut s, t.order());
+            ball.taylor_series(&mut s, &mut Default::default(), t.order());
             (2..=t.order())
                 .find(|&p| {
                     s.order = p;
@@ -334,11 +334,17 @@ impl Dynamics<4> for Plain {
     fn constraint_drift(&self, q: &[f64; 4], v: &[f64; 4]) -> [f64; 4] {
         self.0.constraint_drift(q, v)
     }
-    fn taylor_series(&self, s: &mut Series<4>, order: usize) -> bool {
+    type SeriesScratch = <Chain4 as Dynamics<4>>::SeriesScratch;
+    fn taylor_series(
+        &self,
+        s: &mut Series<4>,
+        scratch: &mut Self::SeriesScratch,
+        order: usize,
+    ) -> bool {
         if self.1 == Offered::Nothing {
             return false;
         }
-        let done = self.0.taylor_series(s, order);
+        let done = self.0.taylor_series(s, scratch, order);
         if order >= 7 {
             s.v[2][7] = f64::NAN;
         }
@@ -353,9 +359,10 @@ impl Surfaces<4> for Plain {
         &self,
         wall: W4,
         s: &Series<4>,
+        scratch: &mut Self::SeriesScratch,
         out: &mut dalembert::runtime::taylor::Coefficients,
     ) -> bool {
-        self.1 != Offered::Nothing && self.0.surface_series(wall, s, out)
+        self.1 != Offered::Nothing && self.0.surface_series(wall, s, scratch, out)
     }
 }
 

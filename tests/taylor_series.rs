@@ -3,14 +3,14 @@
 //! themselves on every model (the series re-expanded at a later instant is
 //! the series computed there; the energy is constant along the series;
 //! coefficient 1 of q̇ is the closed-form q̈; the wall's series is f along
-//! the state's series). Taylor's method in the simulator is
-//! `tests/taylor.rs`.
+//! the state's series; the room kept between calls changes no bit).
+//! Taylor's method in the simulator is `tests/taylor.rs`.
 
 use dalembert::for_each_model;
 use dalembert::models::*;
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::Taylor;
-use dalembert::runtime::taylor::{CAPACITY, Series, eval};
+use dalembert::runtime::taylor::{CAPACITY, MAX_ORDER, Series, eval};
 
 mod common;
 use common::{for_random_cases, onto_kernel};
@@ -29,7 +29,8 @@ fn check_series<M: Surfaces<N>, const N: usize>(
     let v = onto_kernel(&m.constraints(q), v);
     let order = 16;
     let mut s = Series::at(q, &v);
-    if !m.taylor_series(&mut s, order) {
+    let mut scratch = M::SeriesScratch::default();
+    if !m.taylor_series(&mut s, &mut scratch, order) {
         return Ok(());
     }
     let Some(acc) = m.closed_form_accelerations(q, &v) else {
@@ -60,7 +61,7 @@ fn check_series<M: Surfaces<N>, const N: usize>(
     let tau = 0.1 * Taylor::default().step(&s).min(1.0 / scale);
     let (q1, v1) = s.state(tau);
     let mut s1 = Series::at(&q1, &v1);
-    assert!(m.taylor_series(&mut s1, order));
+    assert!(m.taylor_series(&mut s1, &mut scratch, order));
     let shifted = |c: &[f64; CAPACITY], k: usize| -> (f64, f64) {
         (k..=order)
             .map(|j| binomial(j, k) * c[j] * tau.powi((j - k) as i32))
@@ -92,7 +93,7 @@ fn check_series<M: Surfaces<N>, const N: usize>(
     // Each wall's series is f along the state's series.
     let mut f = [0.0; CAPACITY];
     for &w in m.walls() {
-        assert!(m.surface_series(w, &s, &mut f));
+        assert!(m.surface_series(w, &s, &mut scratch, &mut f));
         for j in 0..=4 {
             let t = j as f64 * tau;
             let (qq, _) = s.state(t);
@@ -104,6 +105,20 @@ fn check_series<M: Surfaces<N>, const N: usize>(
                 m.name()
             );
         }
+    }
+    // The room for the intermediate series, kept from call to call: in
+    // room that other calls have left full (another state to the highest
+    // order, the walls' series), the series has the same bits as in fresh
+    // room.
+    assert!(m.taylor_series(&mut Series::at(&q1, &v1), &mut scratch, MAX_ORDER));
+    let mut again = Series::at(q, &v);
+    assert!(m.taylor_series(&mut again, &mut scratch, order));
+    assert_eq!(again, s, "{}: the series in used room", m.name());
+    for &w in m.walls() {
+        let mut fresh = [0.0; CAPACITY];
+        assert!(m.surface_series(w, &s, &mut M::SeriesScratch::default(), &mut fresh));
+        assert!(m.surface_series(w, &s, &mut scratch, &mut f));
+        assert_eq!(f, fresh, "{} wall {w:?}: the series in used room", m.name());
     }
     Ok(())
 }
@@ -132,7 +147,7 @@ fn series_exist_where_closed_forms_do() {
         let (q, v) = ([0.5; N], [0.0; N]);
         let mut s = Series::at(&q, &v);
         (
-            m.taylor_series(&mut s, 4),
+            m.taylor_series(&mut s, &mut Default::default(), 4),
             m.closed_form_accelerations(&q, &v).is_some(),
         )
     }
@@ -156,7 +171,8 @@ fn ball_in_flight_is_a_parabola() {
     let q = [0.3, -0.2, 2.0, 0.0, std::f64::consts::FRAC_PI_2, 0.0];
     let v = [1.0, 0.5, 2.0, 0.0, 0.0, 5.0];
     let mut s = Series::at(&q, &v);
-    assert!(ball.taylor_series(&mut s, 20));
+    let mut scratch = ball_bounce::SeriesScratch::default();
+    assert!(ball.taylor_series(&mut s, &mut scratch, 20));
     for k in 2..=20 {
         assert_eq!(s.q[0][k], 0.0, "x, order {k}");
         assert_eq!(s.q[1][k], 0.0, "y, order {k}");
@@ -172,7 +188,7 @@ fn ball_in_flight_is_a_parabola() {
         assert!(s.q[4][k].abs() < 1e-14, "θ, order {k}: {}", s.q[4][k]);
     }
     let mut f = [0.0; CAPACITY];
-    assert!(ball.surface_series(ball_bounce::Wall::Floor, &s, &mut f));
+    assert!(ball.surface_series(ball_bounce::Wall::Floor, &s, &mut scratch, &mut f));
     assert_eq!(&f[..3], &[2.0 - r, 2.0, -g / 2.0]);
 }
 
@@ -186,7 +202,7 @@ fn pendulum_series_is_the_angles() {
     let th0: f64 = 0.9;
     let q = [l * th0.sin(), -l * th0.cos()];
     let mut s = Series::at(&q, &[0.0, 0.0]);
-    assert!(p.taylor_series(&mut s, 12));
+    assert!(p.taylor_series(&mut s, &mut Default::default(), 12));
     let w = g / l;
     let theta = |t: f64| {
         th0 - w * th0.sin() * t * t / 2.0 + w * w * th0.sin() * th0.cos() * t.powi(4) / 24.0

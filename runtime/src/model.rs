@@ -144,15 +144,32 @@ pub trait Dynamics<const N: usize>: Model<N, N> {
         None
     }
 
+    /// Room for the intermediate coefficients of the model's series
+    /// ([`Dynamics::taylor_series`], [`Surfaces::surface_series`]), kept by
+    /// the caller from one call to the next, so that a call neither zeroes
+    /// its intermediate arrays nor holds them on its stack (`chain_8`'s are
+    /// 24 KiB). A generated model's is its module's `SeriesScratch`; `()`
+    /// where a model keeps none. `Default` gives room ready for any call;
+    /// what a call leaves in it is only ever overwritten, never read, by the
+    /// next.
+    type SeriesScratch: Default;
+
     /// The Taylor series of the motion through the state held at order 0
     /// of `series` (q(t₀), q̇(t₀)): fills its coefficients of orders 1 to
-    /// `order` (at most [`crate::taylor::MAX_ORDER`]) and sets its order.
+    /// `order` (at most [`crate::taylor::MAX_ORDER`]) and sets its order,
+    /// with `scratch` as room for the intermediate series (pass the same
+    /// one call after call; `&mut Default::default()` for a single call).
     /// Generated models have it wherever they write q̈ out (the Taylor
     /// transform of that program, [`Dynamics::closed_form_accelerations`]);
     /// `false` (the default) means the model has none and the series is
     /// untouched.
-    fn taylor_series(&self, series: &mut Series<N>, order: usize) -> bool {
-        let _ = (series, order);
+    fn taylor_series(
+        &self,
+        series: &mut Series<N>,
+        scratch: &mut Self::SeriesScratch,
+        order: usize,
+    ) -> bool {
+        let _ = (series, scratch, order);
         false
     }
 
@@ -178,10 +195,17 @@ pub trait Surfaces<const N: usize>: Dynamics<N> + Walls<N, N> {
     }
 
     /// The Taylor coefficients of t ↦ f(q(t)) along `series` (see
-    /// [`Dynamics::taylor_series`]), orders 0 to `series.order`, into
-    /// `out`. `false` (the default) means the model has none.
-    fn surface_series(&self, wall: Self::Wall, series: &Series<N>, out: &mut Coefficients) -> bool {
-        let _ = (wall, series, out);
+    /// [`Dynamics::taylor_series`], whose `scratch` this shares), orders 0
+    /// to `series.order`, into `out`. `false` (the default) means the model
+    /// has none.
+    fn surface_series(
+        &self,
+        wall: Self::Wall,
+        series: &Series<N>,
+        scratch: &mut Self::SeriesScratch,
+        out: &mut Coefficients,
+    ) -> bool {
+        let _ = (wall, series, scratch, out);
         false
     }
 

@@ -213,6 +213,7 @@ fn model_tokens(d: &Ctx) -> TokenStream {
     let ty = format_ident!("{}", d.model.type_name());
     let doc = doc_attr(&d.model.doc);
     let inherent = functions::inherent_impl(d);
+    let scratch = taylor::scratch_struct(d);
     // The runtime's trait and numerics are f64: an f32 model is its
     // inherent functions.
     let trait_impl = match d.scalar {
@@ -239,6 +240,7 @@ fn model_tokens(d: &Ctx) -> TokenStream {
                 Self::new(Params::default())
             }
         }
+        #scratch
         #inherent
         #trait_impl
     }

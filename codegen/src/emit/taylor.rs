@@ -27,6 +27,36 @@ pub(super) fn transforms<'a>(d: &'a Ctx) -> Option<(&'a Transform, &'a [Transfor
 /// vector registers, and each sum holds one while two operands are loaded.
 const HISTORIES_PER_LOOP: usize = 12;
 
+/// The lints the series functions' shape sets off: unused bindings of
+/// the time-constant values, literal constants near π, loops over orders
+/// that index several arrays, copies of coefficients, and `&x` of an
+/// intermediate series held in `scratch` (already a reference).
+fn lints() -> TokenStream {
+    quote! {
+        #[allow(
+            unused_variables,
+            clippy::approx_constant,
+            clippy::needless_range_loop,
+            clippy::manual_memcpy,
+            clippy::needless_borrow
+        )]
+    }
+}
+
+/// `motion_series`'s lints and signature, whichever transform it writes.
+fn motion_signature(n: &Literal) -> TokenStream {
+    let lints = lints();
+    quote! {
+        #lints
+        pub fn motion_series(
+            &self,
+            s: &mut ::dalembert_runtime::taylor::Series<#n>,
+            scratch: &mut SeriesScratch,
+            order: usize,
+        )
+    }
+}
+
 /// `motion_series` and every `{wall}_surface_series`.
 pub(super) fn functions(d: &Ctx) -> TokenStream {
     let Some((motion, walls)) = transforms(d) else {
@@ -62,13 +92,13 @@ pub(super) fn functions(d: &Ctx) -> TokenStream {
     } else {
         &[" `taylor::MAX_ORDER`) by the Taylor transform of `accelerations`,"]
     };
+    let signature = motion_signature(&n);
     let motion_fn = quote! {
         /// The Taylor series of the motion through the state at order 0 of
         /// `s` (q(t₀), q̇(t₀)): fills its orders 1 to `order` (at most
         #(#[doc = #how])*
-        /// one order at a time.
-        #[allow(unused_variables, clippy::approx_constant, clippy::needless_range_loop, clippy::manual_memcpy)]
-        pub fn motion_series(&self, s: &mut ::dalembert_runtime::taylor::Series<#n>, order: usize) {
+        /// one order at a time, in `scratch`'s room.
+        #signature {
             let order = order.min(::dalembert_runtime::taylor::MAX_ORDER);
             #motion_prelude
             for k in 0..order {
@@ -88,18 +118,19 @@ fn wall_functions(d: &Ctx, walls: &[Transform], n: &Literal) -> TokenStream {
     let wall_fns = d.walls.iter().zip(walls).map(|(w, t)| {
         let name = format_ident!("{}_surface_series", w.name);
         let doc = format!(
-            " Wall `{}`: the Taylor coefficients of f(q(t)) along `s`, orders 0 to `s.order`.",
+            " Wall `{}`: the Taylor coefficients of f(q(t)) along `s`, orders 0 to `s.order`, in `scratch`'s room.",
             w.name
         );
         let prelude = prelude(d, t);
         let ops = ops(d, t);
-        let out = output(d, t, 0);
+        let (out, lints) = (output(d, t, 0), lints());
         quote! {
             #[doc = #doc]
-            #[allow(unused_variables, clippy::approx_constant, clippy::needless_range_loop, clippy::manual_memcpy)]
+            #lints
             pub fn #name(
                 &self,
                 s: &::dalembert_runtime::taylor::Series<#n>,
+                scratch: &mut SeriesScratch,
                 out: &mut ::dalembert_runtime::taylor::Coefficients,
             ) {
                 #prelude
@@ -136,15 +167,15 @@ fn momentum_series(
             p[#i] = #f * ik;
         }
     });
+    let signature = motion_signature(n);
     quote! {
         /// The Taylor series of the motion through the state at order 0 of
         /// `s` (q(t₀), q̇(t₀)): fills its orders 1 to `order` (at most
         /// `taylor::MAX_ORDER`) by the Taylor transform of G and ∂L/∂q
         /// (`mass_matrix`, the gradient of T − V), following the momentum
         /// p = G q̇ (ṗ = ∂L/∂q) with G q̇ = p solved at each order, one
-        /// order at a time.
-        #[allow(unused_variables, clippy::approx_constant, clippy::needless_range_loop, clippy::manual_memcpy)]
-        pub fn motion_series(&self, s: &mut ::dalembert_runtime::taylor::Series<#n>, order: usize) {
+        /// order at a time, in `scratch`'s room.
+        #signature {
             let order = order.min(::dalembert_runtime::taylor::MAX_ORDER);
             #prelude
             let mut p = [0.0f64; #n];
@@ -162,7 +193,70 @@ fn momentum_series(
     }
 }
 
-/// The time-constant values and the zeroed intermediate series.
+/// `SeriesScratch`: room for the intermediate series of every function
+/// above, one pool they share (they never run at once), as long as the
+/// longest list of [`arrays`].
+pub(super) fn scratch_struct(d: &Ctx) -> TokenStream {
+    let Some((motion, walls)) = transforms(d) else {
+        return TokenStream::new();
+    };
+    let len = std::iter::once(motion)
+        .chain(walls)
+        .map(|t| arrays(t).len())
+        .max()
+        .unwrap_or(0);
+    let doc = quote! {
+        /// Room for the intermediate series of `motion_series` and the
+        /// walls' `surface_series` (`Dynamics::SeriesScratch`), kept by
+        /// the caller from one call to the next: a call writes each
+        /// coefficient before it reads it, so nothing needs clearing
+        /// between calls.
+    };
+    if len == 0 {
+        return quote! {
+            #doc
+            /// (This model's series keep every intermediate on the stack.)
+            #[derive(Clone, Copy, Debug, Default)]
+            pub struct SeriesScratch;
+        };
+    }
+    let len = Literal::usize_unsuffixed(len);
+    quote! {
+        #doc
+        #[derive(Clone, Debug)]
+        pub struct SeriesScratch {
+            arrays: [::dalembert_runtime::taylor::Coefficients; #len],
+        }
+        impl Default for SeriesScratch {
+            fn default() -> Self {
+                Self { arrays: [[0.0; ::dalembert_runtime::taylor::CAPACITY]; #len] }
+            }
+        }
+    }
+}
+
+/// The intermediate series of `t` kept as whole arrays, in the order they
+/// take their places in `SeriesScratch`: the temporaries read at lower
+/// orders (`x{j}`, the rest keep their current coefficient alone), then the
+/// weighted operands' series (`w{op}`).
+fn arrays(t: &Transform) -> Vec<proc_macro2::Ident> {
+    let temps = t
+        .current_only()
+        .into_iter()
+        .enumerate()
+        .filter(|(_, current)| !current)
+        .map(|(j, _)| format_ident!("x{j}"));
+    let weights = t
+        .ops
+        .iter()
+        .enumerate()
+        .filter(|(_, op)| weighted(op))
+        .map(|(index, _)| format_ident!("w{index}"));
+    temps.chain(weights).collect()
+}
+
+/// The time-constant values, the intermediate series (single coefficients
+/// on the stack, whole arrays in `scratch`).
 fn prelude(d: &Ctx, t: &Transform) -> TokenStream {
     let plan = vec![Emit::Compute; t.numbers.instrs.len()];
     let numbers = body::statements(d, &t.numbers, &plan, Place::Call);
@@ -186,24 +280,24 @@ fn prelude(d: &Ctx, t: &Transform) -> TokenStream {
         });
     // Temporaries read only at the current order keep that coefficient
     // alone (`taylor::Current`, indexed like the arrays).
-    let temps = t.current_only().into_iter().enumerate().map(|(j, current)| {
-        let x = format_ident!("x{j}");
-        if current {
+    let temps = t
+        .current_only()
+        .into_iter()
+        .enumerate()
+        .filter(|(_, current)| *current)
+        .map(|(j, _)| {
+            let x = format_ident!("x{j}");
             quote! { let mut #x = ::dalembert_runtime::taylor::Current::default(); }
-        } else {
-            quote! { let mut #x: ::dalembert_runtime::taylor::Coefficients = [0.0; ::dalembert_runtime::taylor::CAPACITY]; }
-        }
-    });
-    let weights = t.ops.iter().enumerate().filter(|(_, op)| weighted(op)).map(|(index, _)| {
-        let w = format_ident!("w{index}");
-        quote! { let mut #w: ::dalembert_runtime::taylor::Coefficients = [0.0; ::dalembert_runtime::taylor::CAPACITY]; }
-    });
+        });
+    let arrays = arrays(t);
+    let arrays =
+        (!arrays.is_empty()).then(|| quote! { let [#(#arrays,)* ..] = &mut scratch.arrays; });
     let factor = t.solve.as_ref().map(|solve| {
         let n = solve.x.len();
         let len = Literal::usize_unsuffixed(n * (n + 1) / 2);
         quote! { let mut factor = [0.0f64; #len]; }
     });
-    quote! { #(#params)* #numbers #(#temps)* #(#weights)* #factor }
+    quote! { #(#params)* #numbers #(#temps)* #arrays #factor }
 }
 
 /// Whether an op's history is weighted by j (it keeps the series j·xⱼ of

@@ -82,13 +82,19 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
             let walls_work = work(walls.iter().map(Transform::work).sum());
             let arms = d.walls.iter().zip(&variants).map(|(w, v)| {
                 let f = format_ident!("{}_surface_series", w.name);
-                quote! { Wall::#v => self.#f(series, out) }
+                quote! { Wall::#v => self.#f(series, scratch, out) }
             });
             (
                 quote! {
+                    type SeriesScratch = SeriesScratch;
                     #[inline]
-                    fn taylor_series(&self, series: &mut ::dalembert_runtime::taylor::Series<#nl>, order: usize) -> bool {
-                        self.motion_series(series, order);
+                    fn taylor_series(
+                        &self,
+                        series: &mut ::dalembert_runtime::taylor::Series<#nl>,
+                        scratch: &mut SeriesScratch,
+                        order: usize,
+                    ) -> bool {
+                        self.motion_series(series, scratch, order);
                         true
                     }
                 },
@@ -98,6 +104,7 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
                         &self,
                         wall: Wall,
                         series: &::dalembert_runtime::taylor::Series<#nl>,
+                        scratch: &mut SeriesScratch,
                         out: &mut ::dalembert_runtime::taylor::Coefficients,
                     ) -> bool {
                         match wall { #(#arms,)* }
@@ -113,7 +120,7 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
                 },
             )
         }
-        None => (TokenStream::new(), TokenStream::new()),
+        None => (quote! { type SeriesScratch = (); }, TokenStream::new()),
     };
     quote! {
         #model_impl

@@ -443,7 +443,10 @@ impl<const N: usize> Dynamics<N> for Interpreted<N> {
     fn closed_form_accelerations(&self, q: &[f64; N], v: &[f64; N]) -> Option<[f64; N]> {
         self.accelerations.as_ref().map(|c| self.vector(c, q, v))
     }
-    fn taylor_series(&self, series: &mut Series<N>, order: usize) -> bool {
+    /// The interpreter keeps its room itself (`SeriesPrograms::workspace`,
+    /// sized by the first call and reused by every simulator after it).
+    type SeriesScratch = ();
+    fn taylor_series(&self, series: &mut Series<N>, _: &mut (), order: usize) -> bool {
         let Some(sp) = &self.series else {
             return false;
         };
@@ -469,7 +472,13 @@ impl<const N: usize> Surfaces<N> for Interpreted<N> {
     fn surface_hessian(&self, wall: WallIndex, q: &[f64; N], v: &[f64; N]) -> Option<f64> {
         Some(self.scalar(&self.wall(wall).surface_hessian, q, v))
     }
-    fn surface_series(&self, wall: WallIndex, series: &Series<N>, out: &mut Coefficients) -> bool {
+    fn surface_series(
+        &self,
+        wall: WallIndex,
+        series: &Series<N>,
+        _: &mut (),
+        out: &mut Coefficients,
+    ) -> bool {
         let Some(sp) = &self.series else {
             return false;
         };

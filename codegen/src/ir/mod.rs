@@ -44,6 +44,7 @@ pub(crate) const RUST_KEYWORDS: &[&str] = &[
 pub(crate) const GENERATED_TYPE_NAMES: &[&str] = &[
     "Params",
     "Wall",
+    "SeriesScratch",
     "Self",
     "Default",
     "Clone",

@@ -40,7 +40,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         t0: f64,
         step: f64,
     ) -> Result<Collision<M::Wall, N>, SimError<M::Wall>> {
-        let window = self.simultaneity_window(tc, step);
+        let window = self.settings.simultaneity_window(tc, step);
         let collision = self.resolve(k, tc, y, window)?;
         self.state = State {
             t: tc,

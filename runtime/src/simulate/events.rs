@@ -4,7 +4,7 @@
 
 use super::integrator::{Method, RungeKutta, Trial};
 use super::phase::Phase;
-use super::thresholds::{ROOT_ITERATIONS, SHORTEST_AIM_ULPS, SIMULTANEOUS_ULPS};
+use super::thresholds::{ROOT_ITERATIONS, SHORTEST_AIM_ULPS};
 use super::{SimError, Simulator};
 use crate::{Surfaces, libm, linalg};
 
@@ -91,7 +91,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             }
         }
         if let (Some(a), Some(b)) = (best, second)
-            && b.t - a.t <= self.simultaneity_window(a.t, h)
+            && b.t - a.t <= self.settings.simultaneity_window(a.t, h)
         {
             return Err(SimError::Simultaneous {
                 first: self.model.walls()[a.wall],
@@ -100,12 +100,6 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             });
         }
         Ok(best)
-    }
-
-    /// How close in time two wall contacts found on a step of length h
-    /// ending near t may be before they count as one simultaneous contact.
-    pub(super) fn simultaneity_window(&self, t: f64, h: f64) -> f64 {
-        (self.settings.simultaneous * h.abs()).max(SIMULTANEOUS_ULPS * f64::EPSILON * t.abs())
     }
 
     /// Where on the step (θ ∈ [0, 1]) wall `k` is first met, if it is.

@@ -96,8 +96,9 @@ pub struct Simulator<'m, M: Surfaces<N>, const N: usize> {
     low_order_first: bool,
     low_order: usize,
     /// Taylor's method: the series of the current step, a buffer reused
-    /// by every step.
+    /// by every step, and the room for the model's intermediate series.
     series: Series<N>,
+    scratch: M::SeriesScratch,
     /// The last step's motion ([`Simulator::state_at`]).
     last: Option<LastStep<N>>,
     stats: Stats,
@@ -199,6 +200,7 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
             low_order_first: true,
             low_order,
             series: Series::at(&start.q, &start.v),
+            scratch: Default::default(),
             last: None,
             stats,
         })

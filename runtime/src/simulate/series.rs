@@ -21,12 +21,13 @@ pub(super) fn offered<M: Surfaces<N>, const N: usize>(
     start: &State<N>,
 ) -> Result<(), SimError<M::Wall>> {
     let mut s = Series::at(&start.q, &start.v);
-    if !m.taylor_series(&mut s, 1) {
+    let scratch = &mut M::SeriesScratch::default();
+    if !m.taylor_series(&mut s, scratch, 1) {
         return Err(SimError::NoSeries);
     }
     let mut f = [0.0; CAPACITY];
     for &wall in m.walls() {
-        if !m.surface_series(wall, &s, &mut f) {
+        if !m.surface_series(wall, &s, scratch, &mut f) {
             return Err(SimError::NoSeries);
         }
     }
@@ -93,7 +94,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     fn series(&mut self, method: &Plan, order: usize, left: f64) -> Result<f64, SimError<M::Wall>> {
         let s = &mut self.series;
         s.restart(&self.state.q, &self.state.v);
-        if !self.model.taylor_series(s, order) {
+        if !self.model.taylor_series(s, &mut self.scratch, order) {
             return Err(SimError::NoSeries);
         }
         self.stats.evaluations += 1;
@@ -115,13 +116,14 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
 
     /// The first collision on the step of length h along `self.series`:
     /// the wall's index and τ; grazing and simultaneous contacts as errors.
-    fn first_collision(&self, h: f64) -> Result<Option<(usize, f64)>, SimError<M::Wall>> {
+    fn first_collision(&mut self, h: f64) -> Result<Option<(usize, f64)>, SimError<M::Wall>> {
         let (t0, m, s) = (self.state.t, self.model, &self.series);
+        let scratch = &mut self.scratch;
         let mut best: Option<(usize, f64)> = None;
         let mut second: Option<f64> = None;
         let mut f = [0.0; CAPACITY];
         for (k, &wall) in m.walls().iter().enumerate() {
-            m.surface_series(wall, s, &mut f);
+            m.surface_series(wall, s, scratch, &mut f);
             let departing = self.departing & (1 << k) != 0;
             let tau = match first_root(&f, s.order, h, departing) {
                 Ok(Some(tau)) => tau,
@@ -143,7 +145,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             }
         }
         if let (Some((k, a)), Some(b)) = (best, second)
-            && b - a <= self.simultaneity_window(t0 + a, h)
+            && b - a <= self.settings.simultaneity_window(t0 + a, h)
         {
             let other = m
                 .walls()
@@ -151,7 +153,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
                 .enumerate()
                 .find(|(j, w)| {
                     *j != k && {
-                        m.surface_series(**w, s, &mut f);
+                        m.surface_series(**w, s, scratch, &mut f);
                         first_root(&f, s.order, h, self.departing & (1 << j) != 0) == Ok(Some(b))
                     }
                 })

@@ -2,6 +2,7 @@
 //! collisions, counters and errors.
 
 use super::integrator::{DormandPrince, Integrator};
+use super::thresholds::SIMULTANEOUS_ULPS;
 use crate::dynamics::DynamicsError;
 use crate::linalg::ProjectorError;
 
@@ -25,6 +26,14 @@ pub struct Settings {
     /// Points per step (besides its ends) at which each wall's f is sampled
     /// for sign changes on the dense output.
     pub samples: usize,
+}
+
+impl Settings {
+    /// How close in time two wall contacts found on a step of length h
+    /// ending near t may be before they count as one simultaneous contact.
+    pub(super) fn simultaneity_window(&self, t: f64, h: f64) -> f64 {
+        (self.simultaneous * h.abs()).max(SIMULTANEOUS_ULPS * f64::EPSILON * t.abs())
+    }
 }
 
 impl Default for Settings {
