@@ -1,310 +1,19 @@
-//! The Taylor-mode functions of a model whose q̈ is in closed form: the
-//! series of the motion (`motion_series`) and, per wall, of f along it
-//! (`{wall}_surface_series`), each the Taylor transform
-//! ([`crate::program::Transform`]) of a program the table already holds,
-//! written out as one loop over the orders. Order 0 is the program on the
-//! values; at each order k ≥ 1 one inner loop over j = 1..k−1 sums every
-//! convolution's history side by side, then each operation is finished in
-//! program order (`dalembert_runtime::taylor`'s `*_finish`). f64 only (the
-//! runtime's series are f64).
+//! The statements of one order of a series function: order 0's values,
+//! and at each order k ≥ 1 the history loops (every convolution's sum over
+//! j = 1..k−1 side by side) and each operation's finish in program order.
 
 use std::ops::Range;
 
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
-use super::Ctx;
-use super::body::{self, Place};
-use crate::program::{Emit, Op, Program, Series, Slot, Solve, Term, Transform};
-
-/// The model's transforms: q̈'s, then each wall's f's (`None` for f32 or
-/// where q̈ is not written out: then the model has no series at all).
-pub(super) fn transforms<'a>(d: &'a Ctx) -> Option<(&'a Transform, &'a [Transform])> {
-    d.series.as_ref().map(|(m, w)| (m, w.as_slice()))
-}
+use super::super::Ctx;
+use super::super::body;
+use crate::program::{Op, Program, Series, Slot, Solve, Term, Transform};
 
 /// Histories summed side by side in one loop over j: x86-64 has 16
 /// vector registers, and each sum holds one while two operands are loaded.
 const HISTORIES_PER_LOOP: usize = 12;
-
-/// The lints the series functions' shape sets off: unused bindings of
-/// the time-constant values, literal constants near π, loops over orders
-/// that index several arrays, copies of coefficients, and `&x` of an
-/// intermediate series held in `scratch` (already a reference).
-fn lints() -> TokenStream {
-    quote! {
-        #[allow(
-            unused_variables,
-            clippy::approx_constant,
-            clippy::needless_range_loop,
-            clippy::manual_memcpy,
-            clippy::needless_borrow
-        )]
-    }
-}
-
-/// `motion_series`'s lints and signature, whichever transform it writes.
-fn motion_signature(n: &Literal) -> TokenStream {
-    let lints = lints();
-    quote! {
-        #lints
-        pub fn motion_series(
-            &self,
-            s: &mut ::dalembert_runtime::taylor::Series<#n>,
-            scratch: &mut SeriesScratch,
-            order: usize,
-        )
-    }
-}
-
-/// `motion_series` and every `{wall}_surface_series`.
-pub(super) fn functions(d: &Ctx) -> TokenStream {
-    let Some((motion, walls)) = transforms(d) else {
-        return TokenStream::new();
-    };
-    let n = Literal::usize_unsuffixed(d.model.velocities.len());
-    let motion_prelude = prelude(d, motion);
-    if let Some(solve) = motion.solve.as_ref().filter(|s| s.momentum) {
-        let walls = wall_functions(d, walls, &n);
-        let motion_fn = momentum_series(d, motion, solve, motion_prelude, &n);
-        return quote! { #motion_fn #walls };
-    }
-    let motion_ops = ops(d, motion);
-    let feedback = (0..d.model.velocities.len()).map(|i| {
-        let i_lit = Literal::usize_unsuffixed(i);
-        // A zero acceleration (a free coordinate) is zero at every order.
-        let out = if zero_output(motion, i) {
-            quote! { 0.0 }
-        } else {
-            let out = output(d, motion, i);
-            quote! { #out * ik }
-        };
-        quote! {
-            s.q[#i_lit][k + 1] = s.v[#i_lit][k] * ik;
-            s.v[#i_lit][k + 1] = #out;
-        }
-    });
-    let how: &[&str] = if motion.solve.is_some() {
-        &[
-            " `taylor::MAX_ORDER`) by the Taylor transform of G and h",
-            " (`mass_matrix`, `forcing`) with G q̈ = −h solved at each order,",
-        ]
-    } else {
-        &[" `taylor::MAX_ORDER`) by the Taylor transform of `accelerations`,"]
-    };
-    let signature = motion_signature(&n);
-    let motion_fn = quote! {
-        /// The Taylor series of the motion through the state at order 0 of
-        /// `s` (q(t₀), q̇(t₀)): fills its orders 1 to `order` (at most
-        #(#[doc = #how])*
-        /// one order at a time, in `scratch`'s room.
-        #signature {
-            let order = order.min(::dalembert_runtime::taylor::MAX_ORDER);
-            #motion_prelude
-            for k in 0..order {
-                #motion_ops
-                let ik = ::dalembert_runtime::taylor::RECIPROCALS[k + 1];
-                #(#feedback)*
-            }
-            s.order = order;
-        }
-    };
-    let wall_fns = wall_functions(d, walls, &n);
-    quote! { #motion_fn #wall_fns }
-}
-
-/// Every `{wall}_surface_series`.
-fn wall_functions(d: &Ctx, walls: &[Transform], n: &Literal) -> TokenStream {
-    let wall_fns = d.walls.iter().zip(walls).map(|(w, t)| {
-        let name = format_ident!("{}_surface_series", w.name);
-        let doc = format!(
-            " Wall `{}`: the Taylor coefficients of f(q(t)) along `s`, orders 0 to `s.order`, in `scratch`'s room.",
-            w.name
-        );
-        let prelude = prelude(d, t);
-        let ops = ops(d, t);
-        let (out, lints) = (output(d, t, 0), lints());
-        quote! {
-            #[doc = #doc]
-            #lints
-            pub fn #name(
-                &self,
-                s: &::dalembert_runtime::taylor::Series<#n>,
-                scratch: &mut SeriesScratch,
-                out: &mut ::dalembert_runtime::taylor::Coefficients,
-            ) {
-                #prelude
-                for k in 0..=s.order.min(::dalembert_runtime::taylor::MAX_ORDER) {
-                    #ops
-                    out[k] = #out;
-                }
-            }
-        }
-    });
-    quote! { #(#wall_fns)* }
-}
-
-/// `motion_series` where the series of the momentum p = G q̇ is followed
-/// (ṗ = ∂L/∂q, the solve's right-hand side): at each order k the ops
-/// that read coordinates only (G's among them), then G₀ q̇ₖ = pₖ −
-/// Σⱼ₌₁..ₖ Gⱼ q̇ₖ₋ⱼ (k ≥ 1; G₀ factored at k = 0), then the ops that read
-/// velocities, then qₖ₊₁ = q̇ₖ/(k + 1) and pₖ₊₁ = (∂L/∂q)ₖ/(k + 1); one
-/// more order of the first ops and the solve gives q̇ at the last order.
-fn momentum_series(
-    d: &Ctx,
-    t: &Transform,
-    solve: &Solve,
-    prelude: TokenStream,
-    n: &Literal,
-) -> TokenStream {
-    let before = ops_in(d, t, 0..solve.split, true);
-    let after = ops_in(d, t, solve.split..t.ops.len(), false);
-    let feedback = solve.rhs.iter().enumerate().map(|(i, f)| {
-        let i = Literal::usize_unsuffixed(i);
-        let f = coefficient(d, t, f, At::Any);
-        quote! {
-            s.q[#i][k + 1] = s.v[#i][k] * ik;
-            p[#i] = #f * ik;
-        }
-    });
-    let signature = motion_signature(n);
-    quote! {
-        /// The Taylor series of the motion through the state at order 0 of
-        /// `s` (q(t₀), q̇(t₀)): fills its orders 1 to `order` (at most
-        /// `taylor::MAX_ORDER`) by the Taylor transform of G and ∂L/∂q
-        /// (`mass_matrix`, the gradient of T − V), following the momentum
-        /// p = G q̇ (ṗ = ∂L/∂q) with G q̇ = p solved at each order, one
-        /// order at a time, in `scratch`'s room.
-        #signature {
-            let order = order.min(::dalembert_runtime::taylor::MAX_ORDER);
-            #prelude
-            let mut p = [0.0f64; #n];
-            for k in 0..=order {
-                #before
-                if k == order {
-                    break;
-                }
-                #after
-                let ik = ::dalembert_runtime::taylor::RECIPROCALS[k + 1];
-                #(#feedback)*
-            }
-            s.order = order;
-        }
-    }
-}
-
-/// `SeriesScratch`: room for the intermediate series of every function
-/// above, one pool they share (they never run at once), as long as the
-/// longest list of [`arrays`].
-pub(super) fn scratch_struct(d: &Ctx) -> TokenStream {
-    let Some((motion, walls)) = transforms(d) else {
-        return TokenStream::new();
-    };
-    let len = std::iter::once(motion)
-        .chain(walls)
-        .map(|t| arrays(t).len())
-        .max()
-        .unwrap_or(0);
-    let doc = quote! {
-        /// Room for the intermediate series of `motion_series` and the
-        /// walls' `surface_series` (`Dynamics::SeriesScratch`), kept by
-        /// the caller from one call to the next: a call writes each
-        /// coefficient before it reads it, so nothing needs clearing
-        /// between calls.
-    };
-    if len == 0 {
-        return quote! {
-            #doc
-            /// (This model's series keep every intermediate on the stack.)
-            #[derive(Clone, Copy, Debug, Default)]
-            pub struct SeriesScratch;
-        };
-    }
-    let len = Literal::usize_unsuffixed(len);
-    quote! {
-        #doc
-        #[derive(Clone, Debug)]
-        pub struct SeriesScratch {
-            arrays: [::dalembert_runtime::taylor::Coefficients; #len],
-        }
-        impl Default for SeriesScratch {
-            fn default() -> Self {
-                Self { arrays: [[0.0; ::dalembert_runtime::taylor::CAPACITY]; #len] }
-            }
-        }
-    }
-}
-
-/// The intermediate series of `t` kept as whole arrays, in the order they
-/// take their places in `SeriesScratch`: the temporaries read at lower
-/// orders (`x{j}`, the rest keep their current coefficient alone), then the
-/// weighted operands' series (`w{op}`).
-fn arrays(t: &Transform) -> Vec<proc_macro2::Ident> {
-    let temps = t
-        .current_only()
-        .into_iter()
-        .enumerate()
-        .filter(|(_, current)| !current)
-        .map(|(j, _)| format_ident!("x{j}"));
-    let weights = t
-        .ops
-        .iter()
-        .enumerate()
-        .filter(|(_, op)| weighted(op))
-        .map(|(index, _)| format_ident!("w{index}"));
-    temps.chain(weights).collect()
-}
-
-/// The time-constant values, the intermediate series (single coefficients
-/// on the stack, whole arrays in `scratch`).
-fn prelude(d: &Ctx, t: &Transform) -> TokenStream {
-    let plan = vec![Emit::Compute; t.numbers.instrs.len()];
-    let numbers = body::statements(d, &t.numbers, &plan, Place::Call);
-    // Series operations read parameters directly too (a product with m);
-    // those the numbers read are bound by their statements.
-    let read: Vec<Slot> = t
-        .numbers
-        .instrs
-        .iter()
-        .flat_map(|ins| ins.sources().to_vec())
-        .collect();
-    let params = d
-        .model
-        .params
-        .iter()
-        .enumerate()
-        .filter(move |(i, _)| !read.contains(&Slot::Input(*i)))
-        .map(|(i, p)| {
-            let (name, field) = (format_ident!("i{i}"), super::ident(&p.name));
-            quote! { let #name: f64 = self.params.#field; }
-        });
-    // Temporaries read only at the current order keep that coefficient
-    // alone (`taylor::Current`, indexed like the arrays).
-    let temps = t
-        .current_only()
-        .into_iter()
-        .enumerate()
-        .filter(|(_, current)| *current)
-        .map(|(j, _)| {
-            let x = format_ident!("x{j}");
-            quote! { let mut #x = ::dalembert_runtime::taylor::Current::default(); }
-        });
-    let arrays = arrays(t);
-    let arrays =
-        (!arrays.is_empty()).then(|| quote! { let [#(#arrays,)* ..] = &mut scratch.arrays; });
-    let factor = t.solve.as_ref().map(|solve| {
-        let n = solve.x.len();
-        let len = Literal::usize_unsuffixed(n * (n + 1) / 2);
-        quote! { let mut factor = [0.0f64; #len]; }
-    });
-    quote! { #(#params)* #numbers #(#temps)* #arrays #factor }
-}
-
-/// Whether an op's history is weighted by j (it keeps the series j·xⱼ of
-/// the weighted operand, `w{op}`).
-fn weighted(op: &Op) -> bool {
-    matches!(op, Op::Exp { .. } | Op::Log { .. } | Op::SinCos { .. })
-}
 
 /// A series as an expression (`s.q[i]`, `s.v[i]`, `x{j}`).
 fn series(s: Series) -> TokenStream {
@@ -327,29 +36,15 @@ fn series(s: Series) -> TokenStream {
 fn number(d: &Ctx, p: &Program, s: Slot) -> TokenStream {
     body::slot(d, p, s)
 }
-
-/// Whether output `o` is the constant 0.
-fn zero_output(t: &Transform, o: usize) -> bool {
-    matches!(t.outputs[o], Term::Number(Slot::Const(i)) if t.numbers.consts[i] == 0.0)
-}
-
-/// Coefficient k of output `o`.
-fn output(d: &Ctx, t: &Transform, o: usize) -> TokenStream {
-    if zero_output(t, o) {
-        return quote! { 0.0 };
-    }
-    coefficient(d, t, &Some(t.outputs[o]), At::Any)
-}
-
 /// Order k of every op: at k = 0 the values, beyond it the fused history
 /// loops and each op's finish.
-fn ops(d: &Ctx, t: &Transform) -> TokenStream {
+pub(super) fn ops(d: &Ctx, t: &Transform) -> TokenStream {
     ops_in(d, t, 0..t.ops.len(), t.solve.is_some())
 }
 
 /// [`ops`] for the ops in `range` only, followed by the transform's solve
 /// if `solve`.
-fn ops_in(d: &Ctx, t: &Transform, range: Range<usize>, solve: bool) -> TokenStream {
+pub(super) fn ops_in(d: &Ctx, t: &Transform, range: Range<usize>, solve: bool) -> TokenStream {
     let group = &t.ops[range.clone()];
     if !solve
         && group
@@ -377,7 +72,7 @@ fn ops_in(d: &Ctx, t: &Transform, range: Range<usize>, solve: bool) -> TokenStre
 
 /// Which orders a statement is written for.
 #[derive(Clone, Copy, PartialEq)]
-enum At {
+pub(super) enum At {
     /// Order 0 only.
     Zero,
     /// Orders k ≥ 1 only.
@@ -493,7 +188,7 @@ fn order_zero(d: &Ctx, t: &Transform, range: Range<usize>, solve: Option<&Solve>
 
 /// Coefficient 0 (`At::Zero`), k ≥ 1 (`At::Beyond`) or k (`At::Any`) of a
 /// term (`None`: zero): an output, or an entry of a solve.
-fn coefficient(d: &Ctx, t: &Transform, term: &Option<Term>, at: At) -> TokenStream {
+pub(super) fn coefficient(d: &Ctx, t: &Transform, term: &Option<Term>, at: At) -> TokenStream {
     let k = if at == At::Zero {
         quote! { 0 }
     } else {

@@ -1,0 +1,213 @@
+//! The Taylor-mode functions of a model whose q̈ is in closed form: the
+//! series of the motion (`motion_series`) and, per wall, of f along it
+//! (`{wall}_surface_series`), each the Taylor transform
+//! ([`crate::program::Transform`]) of a program the table already holds,
+//! written out as one loop over the orders. Order 0 is the program on the
+//! values; at each order k ≥ 1 one inner loop over j = 1..k−1 sums every
+//! convolution's history side by side, then each operation is finished in
+//! program order (`dalembert_runtime::taylor`'s `*_finish`). f64 only (the
+//! runtime's series are f64).
+
+//!
+//! - this file: the functions and their signatures;
+//! - [`room`]: `SeriesScratch`, the room the caller keeps for the
+//!   intermediate series, and each function's prelude;
+//! - [`orders`]: the statements of one order (order 0's values, the
+//!   history loops and each operation's finish).
+
+mod orders;
+mod room;
+
+use proc_macro2::{Literal, TokenStream};
+use quote::{format_ident, quote};
+
+use super::Ctx;
+use crate::program::{Slot, Solve, Term, Transform};
+use orders::{At, coefficient, ops, ops_in};
+use room::prelude;
+pub(super) use room::scratch_struct;
+
+/// The model's transforms: q̈'s, then each wall's f's (`None` for f32 or
+/// where q̈ is not written out: then the model has no series at all).
+pub(super) fn transforms<'a>(d: &'a Ctx) -> Option<(&'a Transform, &'a [Transform])> {
+    d.series.as_ref().map(|(m, w)| (m, w.as_slice()))
+}
+
+/// The lints the series functions' shape sets off: unused bindings of
+/// the time-constant values, literal constants near π, loops over orders
+/// that index several arrays, copies of coefficients, and `&x` of an
+/// intermediate series held in `scratch` (already a reference).
+fn lints() -> TokenStream {
+    quote! {
+        #[allow(
+            unused_variables,
+            clippy::approx_constant,
+            clippy::needless_range_loop,
+            clippy::manual_memcpy,
+            clippy::needless_borrow
+        )]
+    }
+}
+
+/// `motion_series`'s lints and signature, whichever transform it writes.
+fn motion_signature(n: &Literal) -> TokenStream {
+    let lints = lints();
+    quote! {
+        #lints
+        pub fn motion_series(
+            &self,
+            s: &mut ::dalembert_runtime::taylor::Series<#n>,
+            scratch: &mut SeriesScratch,
+            order: usize,
+        )
+    }
+}
+
+/// `motion_series` and every `{wall}_surface_series`.
+pub(super) fn functions(d: &Ctx) -> TokenStream {
+    let Some((motion, walls)) = transforms(d) else {
+        return TokenStream::new();
+    };
+    let n = Literal::usize_unsuffixed(d.model.velocities.len());
+    let motion_prelude = prelude(d, motion);
+    if let Some(solve) = motion.solve.as_ref().filter(|s| s.momentum) {
+        let walls = wall_functions(d, walls, &n);
+        let motion_fn = momentum_series(d, motion, solve, motion_prelude, &n);
+        return quote! { #motion_fn #walls };
+    }
+    let motion_ops = ops(d, motion);
+    let feedback = (0..d.model.velocities.len()).map(|i| {
+        let i_lit = Literal::usize_unsuffixed(i);
+        // A zero acceleration (a free coordinate) is zero at every order.
+        let out = if zero_output(motion, i) {
+            quote! { 0.0 }
+        } else {
+            let out = output(d, motion, i);
+            quote! { #out * ik }
+        };
+        quote! {
+            s.q[#i_lit][k + 1] = s.v[#i_lit][k] * ik;
+            s.v[#i_lit][k + 1] = #out;
+        }
+    });
+    let how: &[&str] = if motion.solve.is_some() {
+        &[
+            " `taylor::MAX_ORDER`) by the Taylor transform of G and h",
+            " (`mass_matrix`, `forcing`) with G q̈ = −h solved at each order,",
+        ]
+    } else {
+        &[" `taylor::MAX_ORDER`) by the Taylor transform of `accelerations`,"]
+    };
+    let signature = motion_signature(&n);
+    let motion_fn = quote! {
+        /// The Taylor series of the motion through the state at order 0 of
+        /// `s` (q(t₀), q̇(t₀)): fills its orders 1 to `order` (at most
+        #(#[doc = #how])*
+        /// one order at a time, in `scratch`'s room.
+        #signature {
+            let order = order.min(::dalembert_runtime::taylor::MAX_ORDER);
+            #motion_prelude
+            for k in 0..order {
+                #motion_ops
+                let ik = ::dalembert_runtime::taylor::RECIPROCALS[k + 1];
+                #(#feedback)*
+            }
+            s.order = order;
+        }
+    };
+    let wall_fns = wall_functions(d, walls, &n);
+    quote! { #motion_fn #wall_fns }
+}
+
+/// Every `{wall}_surface_series`.
+fn wall_functions(d: &Ctx, walls: &[Transform], n: &Literal) -> TokenStream {
+    let wall_fns = d.walls.iter().zip(walls).map(|(w, t)| {
+        let name = format_ident!("{}_surface_series", w.name);
+        let doc = format!(
+            " Wall `{}`: the Taylor coefficients of f(q(t)) along `s`, orders 0 to `s.order`, in `scratch`'s room.",
+            w.name
+        );
+        let prelude = prelude(d, t);
+        let ops = ops(d, t);
+        let (out, lints) = (output(d, t, 0), lints());
+        quote! {
+            #[doc = #doc]
+            #lints
+            pub fn #name(
+                &self,
+                s: &::dalembert_runtime::taylor::Series<#n>,
+                scratch: &mut SeriesScratch,
+                out: &mut ::dalembert_runtime::taylor::Coefficients,
+            ) {
+                #prelude
+                for k in 0..=s.order.min(::dalembert_runtime::taylor::MAX_ORDER) {
+                    #ops
+                    out[k] = #out;
+                }
+            }
+        }
+    });
+    quote! { #(#wall_fns)* }
+}
+
+/// `motion_series` where the series of the momentum p = G q̇ is followed
+/// (ṗ = ∂L/∂q, the solve's right-hand side): at each order k the ops
+/// that read coordinates only (G's among them), then G₀ q̇ₖ = pₖ −
+/// Σⱼ₌₁..ₖ Gⱼ q̇ₖ₋ⱼ (k ≥ 1; G₀ factored at k = 0), then the ops that read
+/// velocities, then qₖ₊₁ = q̇ₖ/(k + 1) and pₖ₊₁ = (∂L/∂q)ₖ/(k + 1); one
+/// more order of the first ops and the solve gives q̇ at the last order.
+fn momentum_series(
+    d: &Ctx,
+    t: &Transform,
+    solve: &Solve,
+    prelude: TokenStream,
+    n: &Literal,
+) -> TokenStream {
+    let before = ops_in(d, t, 0..solve.split, true);
+    let after = ops_in(d, t, solve.split..t.ops.len(), false);
+    let feedback = solve.rhs.iter().enumerate().map(|(i, f)| {
+        let i = Literal::usize_unsuffixed(i);
+        let f = coefficient(d, t, f, At::Any);
+        quote! {
+            s.q[#i][k + 1] = s.v[#i][k] * ik;
+            p[#i] = #f * ik;
+        }
+    });
+    let signature = motion_signature(n);
+    quote! {
+        /// The Taylor series of the motion through the state at order 0 of
+        /// `s` (q(t₀), q̇(t₀)): fills its orders 1 to `order` (at most
+        /// `taylor::MAX_ORDER`) by the Taylor transform of G and ∂L/∂q
+        /// (`mass_matrix`, the gradient of T − V), following the momentum
+        /// p = G q̇ (ṗ = ∂L/∂q) with G q̇ = p solved at each order, one
+        /// order at a time, in `scratch`'s room.
+        #signature {
+            let order = order.min(::dalembert_runtime::taylor::MAX_ORDER);
+            #prelude
+            let mut p = [0.0f64; #n];
+            for k in 0..=order {
+                #before
+                if k == order {
+                    break;
+                }
+                #after
+                let ik = ::dalembert_runtime::taylor::RECIPROCALS[k + 1];
+                #(#feedback)*
+            }
+            s.order = order;
+        }
+    }
+}
+
+/// Whether output `o` is the constant 0.
+fn zero_output(t: &Transform, o: usize) -> bool {
+    matches!(t.outputs[o], Term::Number(Slot::Const(i)) if t.numbers.consts[i] == 0.0)
+}
+
+/// Coefficient k of output `o`.
+fn output(d: &Ctx, t: &Transform, o: usize) -> TokenStream {
+    if zero_output(t, o) {
+        return quote! { 0.0 };
+    }
+    coefficient(d, t, &Some(t.outputs[o]), At::Any)
+}

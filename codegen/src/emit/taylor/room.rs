@@ -1,0 +1,124 @@
+//! `SeriesScratch`, the room the caller keeps for a model's intermediate
+//! series from one call to the next, and each series function's prelude:
+//! its time-constant values and where its intermediate series live.
+
+use proc_macro2::{Literal, TokenStream};
+use quote::{format_ident, quote};
+
+use super::super::Ctx;
+use super::super::body::{self, Place};
+use super::transforms;
+use crate::program::{Emit, Op, Slot, Transform};
+
+/// `SeriesScratch`: room for the intermediate series of every function
+/// above, one pool they share (they never run at once), as long as the
+/// longest list of [`arrays`].
+pub(in crate::emit) fn scratch_struct(d: &Ctx) -> TokenStream {
+    let Some((motion, walls)) = transforms(d) else {
+        return TokenStream::new();
+    };
+    let len = std::iter::once(motion)
+        .chain(walls)
+        .map(|t| arrays(t).len())
+        .max()
+        .unwrap_or(0);
+    let doc = quote! {
+        /// Room for the intermediate series of `motion_series` and the
+        /// walls' `surface_series` (`Dynamics::SeriesScratch`), kept by
+        /// the caller from one call to the next: a call writes each
+        /// coefficient before it reads it, so nothing needs clearing
+        /// between calls.
+    };
+    if len == 0 {
+        return quote! {
+            #doc
+            /// (This model's series keep every intermediate on the stack.)
+            #[derive(Clone, Copy, Debug, Default)]
+            pub struct SeriesScratch;
+        };
+    }
+    let len = Literal::usize_unsuffixed(len);
+    quote! {
+        #doc
+        #[derive(Clone, Debug)]
+        pub struct SeriesScratch {
+            arrays: [::dalembert_runtime::taylor::Coefficients; #len],
+        }
+        impl Default for SeriesScratch {
+            fn default() -> Self {
+                Self { arrays: [[0.0; ::dalembert_runtime::taylor::CAPACITY]; #len] }
+            }
+        }
+    }
+}
+
+/// The intermediate series of `t` kept as whole arrays, in the order they
+/// take their places in `SeriesScratch`: the temporaries read at lower
+/// orders (`x{j}`, the rest keep their current coefficient alone), then the
+/// weighted operands' series (`w{op}`).
+fn arrays(t: &Transform) -> Vec<proc_macro2::Ident> {
+    let temps = t
+        .current_only()
+        .into_iter()
+        .enumerate()
+        .filter(|(_, current)| !current)
+        .map(|(j, _)| format_ident!("x{j}"));
+    let weights = t
+        .ops
+        .iter()
+        .enumerate()
+        .filter(|(_, op)| weighted(op))
+        .map(|(index, _)| format_ident!("w{index}"));
+    temps.chain(weights).collect()
+}
+
+/// The time-constant values, the intermediate series (single coefficients
+/// on the stack, whole arrays in `scratch`).
+pub(super) fn prelude(d: &Ctx, t: &Transform) -> TokenStream {
+    let plan = vec![Emit::Compute; t.numbers.instrs.len()];
+    let numbers = body::statements(d, &t.numbers, &plan, Place::Call);
+    // Series operations read parameters directly too (a product with m);
+    // those the numbers read are bound by their statements.
+    let read: Vec<Slot> = t
+        .numbers
+        .instrs
+        .iter()
+        .flat_map(|ins| ins.sources().to_vec())
+        .collect();
+    let params = d
+        .model
+        .params
+        .iter()
+        .enumerate()
+        .filter(move |(i, _)| !read.contains(&Slot::Input(*i)))
+        .map(|(i, p)| {
+            let (name, field) = (format_ident!("i{i}"), super::super::ident(&p.name));
+            quote! { let #name: f64 = self.params.#field; }
+        });
+    // Temporaries read only at the current order keep that coefficient
+    // alone (`taylor::Current`, indexed like the arrays).
+    let temps = t
+        .current_only()
+        .into_iter()
+        .enumerate()
+        .filter(|(_, current)| *current)
+        .map(|(j, _)| {
+            let x = format_ident!("x{j}");
+            quote! { let mut #x = ::dalembert_runtime::taylor::Current::default(); }
+        });
+    let arrays = arrays(t);
+    let arrays =
+        (!arrays.is_empty()).then(|| quote! { let [#(#arrays,)* ..] = &mut scratch.arrays; });
+    let factor = t.solve.as_ref().map(|solve| {
+        let n = solve.x.len();
+        let len = Literal::usize_unsuffixed(n * (n + 1) / 2);
+        quote! { let mut factor = [0.0f64; #len]; }
+    });
+    quote! { #(#params)* #numbers #(#temps)* #arrays #factor }
+}
+
+/// Whether an op's history is weighted by j (it keeps the series j·xⱼ of
+/// the weighted operand, `w{op}`).
+fn weighted(op: &Op) -> bool {
+    matches!(op, Op::Exp { .. } | Op::Log { .. } | Op::SinCos { .. })
+}
