@@ -179,10 +179,12 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
         let mut stats = Stats::default();
         let f0 = derivative(model, &mut stats, start.t, &y)?;
         let mut engine = settings.integrator.engine();
+        let (mut series, mut scratch) =
+            (Series::at(&start.q, &start.v), M::SeriesScratch::default());
         let (proposal, low_order) = match &mut engine {
             Engine::RungeKutta(m) => (m.initial_step(&y, &f0), 0),
             Engine::Taylor(t) => {
-                series::offered(model, &start)?;
+                series::offered(model, &mut series, &mut scratch)?;
                 *t = t.fitted(model.series_work(), N, model.walls().len());
                 (f64::INFINITY, Taylor::FIRST_TRIAL_ORDER)
             }
@@ -199,8 +201,8 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
             last_collision: None,
             low_order_first: true,
             low_order,
-            series: Series::at(&start.q, &start.v),
-            scratch: Default::default(),
+            series,
+            scratch,
             last: None,
             stats,
         })

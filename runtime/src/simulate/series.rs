@@ -15,19 +15,19 @@ use crate::dynamics::DynamicsError;
 use crate::taylor::{CAPACITY, Coefficients, Series, degree, eval, eval_with_derivative};
 
 /// Whether `m` has the series Taylor's method needs (of the motion and of
-/// every wall's f).
+/// every wall's f), tried from the state at order 0 of `s` in the
+/// simulator's own series and room.
 pub(super) fn offered<M: Surfaces<N>, const N: usize>(
     m: &M,
-    start: &State<N>,
+    s: &mut Series<N>,
+    scratch: &mut M::SeriesScratch,
 ) -> Result<(), SimError<M::Wall>> {
-    let mut s = Series::at(&start.q, &start.v);
-    let scratch = &mut M::SeriesScratch::default();
-    if !m.taylor_series(&mut s, scratch, 1) {
+    if !m.taylor_series(s, scratch, 1) {
         return Err(SimError::NoSeries);
     }
     let mut f = [0.0; CAPACITY];
     for &wall in m.walls() {
-        if !m.surface_series(wall, &s, scratch, &mut f) {
+        if !m.surface_series(wall, s, scratch, &mut f) {
             return Err(SimError::NoSeries);
         }
     }
