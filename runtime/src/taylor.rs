@@ -22,7 +22,9 @@
 //! At k = 0 each is the function's value. No heap: coefficients live in
 //! fixed arrays of [`CAPACITY`].
 
+mod pair;
 mod solve;
+pub use pair::{Pair, Pairs};
 pub use solve::{ldl_factor, ldl_solve, lower};
 
 /// Coefficients kept per series: orders 0 to [`MAX_ORDER`].

@@ -13,9 +13,12 @@
 //! - [`room`]: `SeriesScratch`, the room the caller keeps for the
 //!   intermediate series, and each function's prelude;
 //! - [`orders`]: the statements of one order (order 0's values, the
-//!   history loops and each operation's finish).
+//!   history loops and each operation's finish);
+//! - [`pairs`]: which histories are summed two at a time, and the lanes
+//!   that keep their operands side by side.
 
 mod orders;
+mod pairs;
 mod room;
 
 use proc_macro2::{Literal, TokenStream};
@@ -24,6 +27,7 @@ use quote::{format_ident, quote};
 use super::Ctx;
 use crate::program::{Slot, Solve, Term, Transform};
 use orders::{At, coefficient, ops, ops_in};
+use pairs::Plan;
 use room::prelude;
 pub(super) use room::scratch_struct;
 
@@ -69,13 +73,14 @@ pub(super) fn functions(d: &Ctx) -> TokenStream {
         return TokenStream::new();
     };
     let n = Literal::usize_unsuffixed(d.model.velocities.len());
-    let motion_prelude = prelude(d, motion);
+    let plan = pairs::plan(motion);
+    let motion_prelude = prelude(d, motion, &plan);
     if let Some(solve) = motion.solve.as_ref().filter(|s| s.momentum) {
         let walls = wall_functions(d, walls, &n);
-        let motion_fn = momentum_series(d, motion, solve, motion_prelude, &n);
+        let motion_fn = momentum_series(d, motion, solve, &plan, motion_prelude, &n);
         return quote! { #motion_fn #walls };
     }
-    let motion_ops = ops(d, motion);
+    let motion_ops = ops(d, motion, &plan);
     let feedback = (0..d.model.velocities.len()).map(|i| {
         let i_lit = Literal::usize_unsuffixed(i);
         // A zero acceleration (a free coordinate) is zero at every order.
@@ -127,8 +132,9 @@ fn wall_functions(d: &Ctx, walls: &[Transform], n: &Literal) -> TokenStream {
             " Wall `{}`: the Taylor coefficients of f(q(t)) along `s`, orders 0 to `s.order`, in `scratch`'s room.",
             w.name
         );
-        let prelude = prelude(d, t);
-        let ops = ops(d, t);
+        let plan = pairs::plan(t);
+        let prelude = prelude(d, t, &plan);
+        let ops = ops(d, t, &plan);
         let (out, lints) = (output(d, t, 0), lints());
         quote! {
             #[doc = #doc]
@@ -160,11 +166,13 @@ fn momentum_series(
     d: &Ctx,
     t: &Transform,
     solve: &Solve,
+    plan: &Plan,
     prelude: TokenStream,
     n: &Literal,
 ) -> TokenStream {
-    let before = ops_in(d, t, 0..solve.split, true);
-    let after = ops_in(d, t, solve.split..t.ops.len(), false);
+    let groups = pairs::groups(t);
+    let before = ops_in(d, t, &groups[0], &plan.groups[0]);
+    let after = ops_in(d, t, &groups[1], &plan.groups[1]);
     let feedback = solve.rhs.iter().enumerate().map(|(i, f)| {
         let i = Literal::usize_unsuffixed(i);
         let f = coefficient(d, t, f, At::Any);

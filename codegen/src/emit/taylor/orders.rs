@@ -9,11 +9,13 @@ use quote::{format_ident, quote};
 
 use super::super::Ctx;
 use super::super::body;
+use super::pairs::{self, Group, GroupPlan, History, Operand, Plan};
 use crate::program::{Op, Program, Series, Slot, Solve, Term, Transform};
 
-/// Histories summed side by side in one loop over j: x86-64 has 16
-/// vector registers, and each sum holds one while two operands are loaded.
-const HISTORIES_PER_LOOP: usize = 12;
+/// Running sums (a pair of histories or a single one) side by side in one
+/// loop over j: x86-64 has 16 vector registers, and each sum holds one
+/// while its two operands are loaded.
+const SUMS_PER_LOOP: usize = 12;
 
 /// A series as an expression (`s.q[i]`, `s.v[i]`, `x{j}`).
 fn series(s: Series) -> TokenStream {
@@ -33,33 +35,46 @@ fn series(s: Series) -> TokenStream {
     }
 }
 
+/// A history's operand as an expression (`w{op}` for a weighted one).
+fn operand(o: Operand) -> TokenStream {
+    match o {
+        Operand::Series(s) => series(s),
+        Operand::Weight(index) => {
+            let w = format_ident!("w{index}");
+            quote! { #w }
+        }
+    }
+}
+
 fn number(d: &Ctx, p: &Program, s: Slot) -> TokenStream {
     body::slot(d, p, s)
 }
-/// Order k of every op: at k = 0 the values, beyond it the fused history
+/// Order k of every op of a transform that runs them in one group (all
+/// but the momentum's): at k = 0 the values, beyond it the fused history
 /// loops and each op's finish.
-pub(super) fn ops(d: &Ctx, t: &Transform) -> TokenStream {
-    ops_in(d, t, 0..t.ops.len(), t.solve.is_some())
+pub(super) fn ops(d: &Ctx, t: &Transform, plan: &Plan) -> TokenStream {
+    let groups = pairs::groups(t);
+    assert_eq!(groups.len(), 1, "the momentum's series runs two groups");
+    ops_in(d, t, &groups[0], &plan.groups[0])
 }
 
-/// [`ops`] for the ops in `range` only, followed by the transform's solve
-/// if `solve`.
-pub(super) fn ops_in(d: &Ctx, t: &Transform, range: Range<usize>, solve: bool) -> TokenStream {
-    let group = &t.ops[range.clone()];
-    if !solve
-        && group
+/// [`ops`] for one group of ops, followed by the transform's solve if the
+/// group has it.
+pub(super) fn ops_in(d: &Ctx, t: &Transform, group: &Group, plan: &GroupPlan) -> TokenStream {
+    let range = group.ops.clone();
+    let ops = &t.ops[range.clone()];
+    if !group.solve
+        && ops
             .iter()
             .all(|op| linear(d, &t.numbers, op, At::Any).is_some())
     {
         // Sums and scalings only: one statement per op at every order.
-        let stmts = group
-            .iter()
-            .flat_map(|op| linear(d, &t.numbers, op, At::Any));
+        let stmts = ops.iter().flat_map(|op| linear(d, &t.numbers, op, At::Any));
         return quote! { #(#stmts)* };
     }
-    let solve = if solve { t.solve.as_ref() } else { None };
-    let zero = order_zero(d, t, range.clone(), solve);
-    let (histories, finishes) = order_k(d, t, range, solve);
+    let solve = group.solve(t);
+    let zero = order_zero(d, t, range, solve);
+    let (histories, finishes) = order_k(d, t, group, plan);
     quote! {
         if k == 0 {
             #zero
@@ -224,26 +239,18 @@ fn store_x(solve: &Solve) -> TokenStream {
     quote! { #(#stores)* }
 }
 
-/// Orders k ≥ 1: the history loops (one accumulator per history, at most
-/// [`HISTORIES_PER_LOOP`] per loop), then each op's finish in program
-/// order.
-fn order_k(
-    d: &Ctx,
-    t: &Transform,
-    range: Range<usize>,
-    solve: Option<&Solve>,
-) -> (TokenStream, TokenStream) {
+/// Orders k ≥ 1: the history loops (pairs of histories and single ones,
+/// at most [`SUMS_PER_LOOP`] running sums per loop), then each op's finish
+/// in program order, then the group's lanes at order k.
+fn order_k(d: &Ctx, t: &Transform, group: &Group, plan: &GroupPlan) -> (TokenStream, TokenStream) {
     let tay = quote! { ::dalembert_runtime::taylor };
-    let mut accs = Vec::new();
-    let mut terms = Vec::new();
-    let mut history = |term: TokenStream| {
-        let h = format_ident!("h{}", accs.len());
-        terms.push(quote! { #h += #term; });
-        accs.push(h.clone());
-        h
-    };
-    let first = range.start;
-    let finishes: Vec<TokenStream> = t.ops[range]
+    // h{i} is history i of `pairs::of_group`; the finishes read them in
+    // that order.
+    let histories = pairs::of_group(t, group);
+    let mut names = (0..histories.len()).map(|i| format_ident!("h{i}"));
+    let mut history = || names.next().expect("one name per history");
+    let first = group.ops.start;
+    let finishes: Vec<TokenStream> = t.ops[group.ops.clone()]
         .iter()
         .enumerate()
         .map(|(i, op)| {
@@ -255,38 +262,38 @@ fn order_k(
             match op {
                 Op::Mul { dst, a, b } => {
                     let (dst, a, b) = (series(*dst), series(*a), series(*b));
-                    let h = history(quote! { #a[j] * #b[r] });
+                    let h = history();
                     quote! { #dst[k] = #tay::mul_finish(&#a, &#b, #h, k); }
                 }
                 Op::Square { dst, a } => {
                     let (dst, a) = (series(*dst), series(*a));
-                    let h = history(quote! { #a[j] * #a[r] });
+                    let h = history();
                     quote! { #dst[k] = #tay::square_finish(&#a, #h, k); }
                 }
                 Op::Recip { dst, a } => {
                     let (dst, a) = (series(*dst), series(*a));
-                    let h = history(quote! { #a[j] * #dst[r] });
+                    let h = history();
                     quote! { #dst[k] = #tay::recip_finish(&#dst, &#a, #h, k); }
                 }
                 Op::Div { dst, a, b } => {
                     let (dst, a, b) = (series(*dst), series(*a), series(*b));
-                    let h = history(quote! { #b[j] * #dst[r] });
+                    let h = history();
                     quote! { #dst[k] = #tay::div_finish(&#dst, &#a, &#b, #h, k); }
                 }
                 Op::Sqrt { dst, a } => {
                     let (dst, a) = (series(*dst), series(*a));
-                    let h = history(quote! { #dst[j] * #dst[r] });
+                    let h = history();
                     quote! { #dst[k] = #tay::sqrt_finish(&#dst, &#a, #h, k); }
                 }
                 Op::Power { dst, a, alpha } => {
                     let (dst, a) = (series(*dst), series(*a));
                     let alpha = Literal::f64_suffixed(*alpha);
-                    let h = history(quote! { #tay::power_weight(#alpha, r, j) * #a[r] * #dst[j] });
+                    let h = history();
                     quote! { #dst[k] = #tay::power_finish(&#dst, &#a, #alpha, #h, k); }
                 }
                 Op::Exp { dst, a } => {
                     let (dst, a) = (series(*dst), series(*a));
-                    let h = history(quote! { #w[j] * #dst[r] });
+                    let h = history();
                     quote! {
                         #w[k] = k as f64 * #a[k];
                         #dst[k] = #tay::exp_finish(&#dst, &#a, #h, k);
@@ -294,7 +301,7 @@ fn order_k(
                 }
                 Op::Log { dst, a } => {
                     let (dst, a) = (series(*dst), series(*a));
-                    let h = history(quote! { #w[j] * #a[r] });
+                    let h = history();
                     quote! {
                         #dst[k] = #tay::log_finish(&#a, #h, k);
                         #w[k] = k as f64 * #dst[k];
@@ -302,8 +309,7 @@ fn order_k(
                 }
                 Op::SinCos { sin, cos, a } => {
                     let (s, c, a) = (series(*sin), series(*cos), series(*a));
-                    let hs = history(quote! { #w[j] * #c[r] });
-                    let hc = history(quote! { #w[j] * #s[r] });
+                    let (hs, hc) = (history(), history());
                     quote! {
                         #w[k] = k as f64 * #a[k];
                         (#s[k], #c[k]) = #tay::sin_cos_finish(&#s, &#c, &#a, #hs, #hc, k);
@@ -316,7 +322,7 @@ fn order_k(
     // The solve: hₖ (or pₖ) − (history + Gₖx₀) per entry of G that
     // varies, in row order (a negated entry added), then the triangular
     // solves.
-    let solve = solve.map(|solve| {
+    let solve = group.solve(t).map(|solve| {
         let mut rows: Vec<TokenStream> = if solve.momentum {
             (0..solve.x.len())
                 .map(|i| {
@@ -333,7 +339,7 @@ fn order_k(
         };
         for (i, m, g, minus) in solve.varying() {
             let (g, x) = (series(g), series(solve.x[m]));
-            let h = history(quote! { #g[j] * #x[r] });
+            let h = history();
             let term = quote! { (#h + #g[k] * #x[0]) };
             let row = &rows[i];
             rows[i] = if minus {
@@ -349,21 +355,82 @@ fn order_k(
             #store
         }
     });
-    // One loop per group of histories: enough independent sums to keep the
-    // floating-point units busy, few enough that they stay in registers.
-    let fused = accs
-        .chunks(HISTORIES_PER_LOOP)
-        .zip(terms.chunks(HISTORIES_PER_LOOP))
-        .map(|(accs, terms)| {
-            quote! {
-                #(let mut #accs = 0.0;)*
-                for j in 1..k {
-                    let r = k - j;
-                    #(#terms)*
-                }
+    // Coefficient k of each lane this group is the first to read, now that
+    // its operands have it: after the finishes, off the chain from one op
+    // to the next (a lane stored between two finishes makes the compiler,
+    // which cannot tell a lane from an operand's array, read the next
+    // operands back from memory, on that chain).
+    let lanes = plan.stores.iter().map(|(id, (a, b))| {
+        let (l, a, b) = (format_ident!("l{id}"), operand(*a), operand(*b));
+        quote! { #l[k] = #tay::Pair::new(#a[k], #b[k]); }
+    });
+    (
+        loops(&histories, plan),
+        quote! { #(#finishes)* #solve #(#lanes)* },
+    )
+}
+
+/// The history loops: one running sum per pair (`hp{n}`, from its lanes)
+/// and per single history (`h{i}`), in the order of their first history,
+/// at most [`SUMS_PER_LOOP`] to a loop; after each loop the pairs' lanes
+/// are bound to their histories' names.
+fn loops(histories: &[History], plan: &GroupPlan) -> TokenStream {
+    let tay = quote! { ::dalembert_runtime::taylor };
+    // (first history, declaration, term at j, binding after the loop)
+    let mut sums: Vec<(usize, TokenStream, TokenStream, TokenStream)> = plan
+        .pairs
+        .iter()
+        .enumerate()
+        .map(|(n, p)| {
+            let hp = format_ident!("hp{n}");
+            let (l, r) = (format_ident!("l{}", p.left), format_ident!("l{}", p.right));
+            let (a, b) = (
+                format_ident!("h{}", p.first),
+                format_ident!("h{}", p.second),
+            );
+            (
+                p.first.min(p.second),
+                quote! { let mut #hp = #tay::Pair::default(); },
+                quote! { #hp = #hp.add_product(#l[j], #r[r]); },
+                quote! { let (#a, #b) = #hp.lanes(); },
+            )
+        })
+        .collect();
+    sums.extend(plan.single.iter().map(|&i| {
+        let h = format_ident!("h{i}");
+        let term = match histories[i] {
+            History::Product { left, right } => {
+                let (a, b) = (operand(left), operand(right));
+                quote! { #a[j] * #b[r] }
             }
-        });
-    (quote! { #(#fused)* }, quote! { #(#finishes)* #solve })
+            History::Power { alpha, a, dst } => {
+                let (a, dst) = (series(a), series(dst));
+                let alpha = Literal::f64_suffixed(alpha);
+                quote! { #tay::power_weight(#alpha, r, j) * #a[r] * #dst[j] }
+            }
+        };
+        (
+            i,
+            quote! { let mut #h = 0.0; },
+            quote! { #h += #term; },
+            TokenStream::new(),
+        )
+    }));
+    sums.sort_by_key(|s| s.0);
+    let fused = sums.chunks(SUMS_PER_LOOP).map(|chunk| {
+        let decls = chunk.iter().map(|s| &s.1);
+        let terms = chunk.iter().map(|s| &s.2);
+        let binds = chunk.iter().map(|s| &s.3);
+        quote! {
+            #(#decls)*
+            for j in 1..k {
+                let r = k - j;
+                #(#terms)*
+            }
+            #(#binds)*
+        }
+    });
+    quote! { #(#fused)* }
 }
 
 /// dst[0] = f(&dst, &a, [extra,] 0): a recurrence on its own result, at

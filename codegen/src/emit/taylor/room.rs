@@ -7,21 +7,27 @@ use quote::{format_ident, quote};
 
 use super::super::Ctx;
 use super::super::body::{self, Place};
+use super::pairs::{self, Plan};
 use super::transforms;
 use crate::program::{Emit, Op, Slot, Transform};
 
 /// `SeriesScratch`: room for the intermediate series of every function
 /// above, one pool they share (they never run at once), as long as the
-/// longest list of [`arrays`].
+/// longest list of [`arrays`], and one pool of lanes (pairs of series side
+/// by side, [`pairs`]) as long as the most any of them uses.
 pub(in crate::emit) fn scratch_struct(d: &Ctx) -> TokenStream {
     let Some((motion, walls)) = transforms(d) else {
         return TokenStream::new();
     };
-    let len = std::iter::once(motion)
-        .chain(walls)
-        .map(|t| arrays(t).len())
-        .max()
-        .unwrap_or(0);
+    let most = |count: &dyn Fn(&Transform) -> usize| {
+        std::iter::once(motion)
+            .chain(walls)
+            .map(count)
+            .max()
+            .unwrap_or(0)
+    };
+    let len = most(&|t| arrays(t).len());
+    let lanes = most(&|t| pairs::plan(t).lanes);
     let doc = quote! {
         /// Room for the intermediate series of `motion_series` and the
         /// walls' `surface_series` (`Dynamics::SeriesScratch`), kept by
@@ -29,7 +35,7 @@ pub(in crate::emit) fn scratch_struct(d: &Ctx) -> TokenStream {
         /// coefficient before it reads it, so nothing needs clearing
         /// between calls.
     };
-    if len == 0 {
+    if len == 0 && lanes == 0 {
         return quote! {
             #doc
             /// (This model's series keep every intermediate on the stack.)
@@ -37,16 +43,25 @@ pub(in crate::emit) fn scratch_struct(d: &Ctx) -> TokenStream {
             pub struct SeriesScratch;
         };
     }
-    let len = Literal::usize_unsuffixed(len);
+    let tay = quote! { ::dalembert_runtime::taylor };
+    let (mut fields, mut values) = (Vec::new(), Vec::new());
+    if len > 0 {
+        let len = Literal::usize_unsuffixed(len);
+        fields.push(quote! { arrays: [#tay::Coefficients; #len], });
+        values.push(quote! { arrays: [[0.0; #tay::CAPACITY]; #len], });
+    }
+    if lanes > 0 {
+        let lanes = Literal::usize_unsuffixed(lanes);
+        fields.push(quote! { pairs: [#tay::Pairs; #lanes], });
+        values.push(quote! { pairs: [[#tay::Pair::default(); #tay::CAPACITY]; #lanes], });
+    }
     quote! {
         #doc
         #[derive(Clone, Debug)]
-        pub struct SeriesScratch {
-            arrays: [::dalembert_runtime::taylor::Coefficients; #len],
-        }
+        pub struct SeriesScratch { #(#fields)* }
         impl Default for SeriesScratch {
             fn default() -> Self {
-                Self { arrays: [[0.0; ::dalembert_runtime::taylor::CAPACITY]; #len] }
+                Self { #(#values)* }
             }
         }
     }
@@ -73,10 +88,10 @@ fn arrays(t: &Transform) -> Vec<proc_macro2::Ident> {
 }
 
 /// The time-constant values, the intermediate series (single coefficients
-/// on the stack, whole arrays in `scratch`).
-pub(super) fn prelude(d: &Ctx, t: &Transform) -> TokenStream {
-    let plan = vec![Emit::Compute; t.numbers.instrs.len()];
-    let numbers = body::statements(d, &t.numbers, &plan, Place::Call);
+/// on the stack, whole arrays in `scratch`) and the lanes of `plan`.
+pub(super) fn prelude(d: &Ctx, t: &Transform, plan: &Plan) -> TokenStream {
+    let compute = vec![Emit::Compute; t.numbers.instrs.len()];
+    let numbers = body::statements(d, &t.numbers, &compute, Place::Call);
     // Series operations read parameters directly too (a product with m);
     // those the numbers read are bound by their statements.
     let read: Vec<Slot> = t
@@ -109,12 +124,14 @@ pub(super) fn prelude(d: &Ctx, t: &Transform) -> TokenStream {
     let arrays = arrays(t);
     let arrays =
         (!arrays.is_empty()).then(|| quote! { let [#(#arrays,)* ..] = &mut scratch.arrays; });
+    let lanes = (0..plan.lanes).map(|id| format_ident!("l{id}"));
+    let lanes = (plan.lanes > 0).then(|| quote! { let [#(#lanes,)* ..] = &mut scratch.pairs; });
     let factor = t.solve.as_ref().map(|solve| {
         let n = solve.x.len();
         let len = Literal::usize_unsuffixed(n * (n + 1) / 2);
         quote! { let mut factor = [0.0f64; #len]; }
     });
-    quote! { #(#params)* #numbers #(#temps)* #arrays #factor }
+    quote! { #(#params)* #numbers #(#temps)* #arrays #lanes #factor }
 }
 
 /// Whether an op's history is weighted by j (it keeps the series j·xⱼ of
