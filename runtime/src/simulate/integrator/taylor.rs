@@ -85,8 +85,9 @@ impl Taylor {
     /// cost least per unit of time. A step of order p costs the series of
     /// the motion and of the walls to p, the state on it (2n(p + 1)
     /// multiply-adds), the root search's samples of each wall's polynomial
-    /// and [`STEP_OVERHEAD`]; its length is the one [`Taylor::step`] takes
-    /// for a series whose coefficients fall like ρ⁻ᵏ: ρ·e⁻² at the
+    /// and 1 000 more for the rest of a step (the step size, the report,
+    /// the bookkeeping); its length is the one [`Taylor::step`] takes for
+    /// a series whose coefficients fall like ρ⁻ᵏ: ρ·e⁻² at the
     /// tolerance's order, ρ·ε^(1/p) (the last two terms below the
     /// tolerance) above it, both with the safety factor. Jorba & Zou's
     /// order balances the series' cost, which grows like p², against the
