@@ -146,7 +146,9 @@ fn wall_functions(d: &Ctx, walls: &[Transform], n: &Literal) -> TokenStream {
                 out: &mut ::dalembert_runtime::taylor::Coefficients,
             ) {
                 #prelude
-                for k in 0..=s.order.min(::dalembert_runtime::taylor::MAX_ORDER) {
+                // An exclusive range: `0..=n` compiles to a loop with an
+                // extra exit test and no unrolling.
+                for k in 0..s.order.min(::dalembert_runtime::taylor::MAX_ORDER) + 1 {
                     #ops
                     out[k] = #out;
                 }
