@@ -26,7 +26,7 @@ use quote::{format_ident, quote};
 
 use super::Ctx;
 use crate::program::{Slot, Solve, Term, Transform};
-use orders::{At, coefficient, ops, ops_in};
+use orders::{At, coefficient, ops};
 use pairs::Plan;
 use room::prelude;
 pub(super) use room::scratch_struct;
@@ -80,7 +80,7 @@ pub(super) fn functions(d: &Ctx) -> TokenStream {
         let motion_fn = momentum_series(d, motion, solve, &plan, motion_prelude, &n);
         return quote! { #motion_fn #walls };
     }
-    let motion_ops = ops(d, motion, &plan);
+    let motion_ops = ops(d, motion, &plan.groups[0]);
     let feedback = (0..d.model.velocities.len()).map(|i| {
         let i_lit = Literal::usize_unsuffixed(i);
         // A zero acceleration (a free coordinate) is zero at every order.
@@ -134,7 +134,7 @@ fn wall_functions(d: &Ctx, walls: &[Transform], n: &Literal) -> TokenStream {
         );
         let plan = pairs::plan(t);
         let prelude = prelude(d, t, &plan);
-        let ops = ops(d, t, &plan);
+        let ops = ops(d, t, &plan.groups[0]);
         let (out, lints) = (output(d, t, 0), lints());
         quote! {
             #[doc = #doc]
@@ -172,9 +172,8 @@ fn momentum_series(
     prelude: TokenStream,
     n: &Literal,
 ) -> TokenStream {
-    let groups = pairs::groups(t);
-    let before = ops_in(d, t, &groups[0], &plan.groups[0]);
-    let after = ops_in(d, t, &groups[1], &plan.groups[1]);
+    let before = ops(d, t, &plan.groups[0]);
+    let after = ops(d, t, &plan.groups[1]);
     let feedback = solve.rhs.iter().enumerate().map(|(i, f)| {
         let i = Literal::usize_unsuffixed(i);
         let f = coefficient(d, t, f, At::Any);

@@ -9,7 +9,7 @@ use quote::{format_ident, quote};
 
 use super::super::Ctx;
 use super::super::body;
-use super::pairs::{self, Group, GroupPlan, History, Operand, Plan};
+use super::pairs::{GroupPlan, History, Operand};
 use crate::program::{Op, Program, Series, Slot, Solve, Term, Transform};
 
 /// Running sums (a pair of histories or a single one) side by side in one
@@ -49,18 +49,11 @@ fn operand(o: Operand) -> TokenStream {
 fn number(d: &Ctx, p: &Program, s: Slot) -> TokenStream {
     body::slot(d, p, s)
 }
-/// Order k of every op of a transform that runs them in one group (all
-/// but the momentum's): at k = 0 the values, beyond it the fused history
-/// loops and each op's finish.
-pub(super) fn ops(d: &Ctx, t: &Transform, plan: &Plan) -> TokenStream {
-    let groups = pairs::groups(t);
-    assert_eq!(groups.len(), 1, "the momentum's series runs two groups");
-    ops_in(d, t, &groups[0], &plan.groups[0])
-}
-
-/// [`ops`] for one group of ops, followed by the transform's solve if the
-/// group has it.
-pub(super) fn ops_in(d: &Ctx, t: &Transform, group: &Group, plan: &GroupPlan) -> TokenStream {
+/// Order k of one group of ops (`plan`'s), followed by the transform's
+/// solve if the group has it: at k = 0 the values, beyond it the fused
+/// history loops and each op's finish.
+pub(super) fn ops(d: &Ctx, t: &Transform, plan: &GroupPlan) -> TokenStream {
+    let group = &plan.group;
     let range = group.ops.clone();
     let ops = &t.ops[range.clone()];
     if !group.solve
@@ -74,7 +67,7 @@ pub(super) fn ops_in(d: &Ctx, t: &Transform, group: &Group, plan: &GroupPlan) ->
     }
     let solve = group.solve(t);
     let zero = order_zero(d, t, range, solve);
-    let (histories, finishes) = order_k(d, t, group, plan);
+    let (histories, finishes) = order_k(d, t, plan);
     quote! {
         if k == 0 {
             #zero
@@ -242,12 +235,12 @@ fn store_x(solve: &Solve) -> TokenStream {
 /// Orders k ≥ 1: the history loops (pairs of histories and single ones,
 /// at most [`SUMS_PER_LOOP`] running sums per loop), then each op's finish
 /// in program order, then the group's lanes at order k.
-fn order_k(d: &Ctx, t: &Transform, group: &Group, plan: &GroupPlan) -> (TokenStream, TokenStream) {
+fn order_k(d: &Ctx, t: &Transform, plan: &GroupPlan) -> (TokenStream, TokenStream) {
     let tay = quote! { ::dalembert_runtime::taylor };
-    // h{i} is history i of `pairs::of_group`; the finishes read them in
-    // that order.
-    let histories = pairs::of_group(t, group);
-    let mut names = (0..histories.len()).map(|i| format_ident!("h{i}"));
+    let group = &plan.group;
+    // h{i} is history i of the plan's; the finishes read them in that
+    // order.
+    let mut names = (0..plan.histories.len()).map(|i| format_ident!("h{i}"));
     let mut history = || names.next().expect("one name per history");
     let first = group.ops.start;
     let finishes: Vec<TokenStream> = t.ops[group.ops.clone()]
@@ -364,17 +357,14 @@ fn order_k(d: &Ctx, t: &Transform, group: &Group, plan: &GroupPlan) -> (TokenStr
         let (l, a, b) = (format_ident!("l{id}"), operand(*a), operand(*b));
         quote! { #l[k] = #tay::Pair::new(#a[k], #b[k]); }
     });
-    (
-        loops(&histories, plan),
-        quote! { #(#finishes)* #solve #(#lanes)* },
-    )
+    (loops(plan), quote! { #(#finishes)* #solve #(#lanes)* })
 }
 
 /// The history loops: one running sum per pair (`hp{n}`, from its lanes)
 /// and per single history (`h{i}`), in the order of their first history,
 /// at most [`SUMS_PER_LOOP`] to a loop; after each loop the pairs' lanes
 /// are bound to their histories' names.
-fn loops(histories: &[History], plan: &GroupPlan) -> TokenStream {
+fn loops(plan: &GroupPlan) -> TokenStream {
     let tay = quote! { ::dalembert_runtime::taylor };
     // (first history, declaration, term at j, binding after the loop)
     let mut sums: Vec<(usize, TokenStream, TokenStream, TokenStream)> = plan
@@ -398,7 +388,7 @@ fn loops(histories: &[History], plan: &GroupPlan) -> TokenStream {
         .collect();
     sums.extend(plan.single.iter().map(|&i| {
         let h = format_ident!("h{i}");
-        let term = match histories[i] {
+        let term = match plan.histories[i] {
             History::Product { left, right } => {
                 let (a, b) = (operand(left), operand(right));
                 quote! { #a[j] * #b[r] }

@@ -40,7 +40,7 @@ pub(super) enum History {
 
 /// The histories of op `index` (of `t.ops`), in the order its finish
 /// reads them.
-pub(super) fn of_op(op: &Op, index: usize) -> Vec<History> {
+fn of_op(op: &Op, index: usize) -> Vec<History> {
     use Operand::{Series as S, Weight as W};
     let product = |left, right| History::Product { left, right };
     match *op {
@@ -61,7 +61,7 @@ pub(super) fn of_op(op: &Op, index: usize) -> Vec<History> {
 
 /// The solve's histories, Σ Gⱼ xₖ₋ⱼ for every entry of G that varies, in
 /// row order.
-pub(super) fn of_solve(solve: &Solve) -> Vec<History> {
+fn of_solve(solve: &Solve) -> Vec<History> {
     solve
         .varying()
         .map(|(_, m, g, _)| History::Product {
@@ -72,7 +72,7 @@ pub(super) fn of_solve(solve: &Solve) -> Vec<History> {
 }
 
 /// A group's histories: its ops' in program order, then its solve's.
-pub(super) fn of_group(t: &Transform, group: &Group) -> Vec<History> {
+fn of_group(t: &Transform, group: &Group) -> Vec<History> {
     let ops = t.ops[group.ops.clone()]
         .iter()
         .enumerate()
@@ -83,7 +83,7 @@ pub(super) fn of_group(t: &Transform, group: &Group) -> Vec<History> {
 
 /// The ops a function runs at each order in one stretch (its history loops,
 /// then their finishes), and whether the transform's solve follows them.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub(super) struct Group {
     pub ops: Range<usize>,
     pub solve: bool,
@@ -99,7 +99,7 @@ impl Group {
 /// A transform's groups, in the order its function runs them: with the
 /// momentum's solve, the ops that read coordinates and the solve, then the
 /// rest; otherwise all ops (and the solve of G q̈ = −h, if any).
-pub(super) fn groups(t: &Transform) -> Vec<Group> {
+fn groups(t: &Transform) -> Vec<Group> {
     match &t.solve {
         Some(solve) if solve.momentum => vec![
             Group {
@@ -131,6 +131,10 @@ pub(super) struct Paired {
 /// One group's part of the plan.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub(super) struct GroupPlan {
+    /// The group's ops and whether it runs the solve.
+    pub group: Group,
+    /// Its histories ([`of_group`]), in the order the finishes read them.
+    pub histories: Vec<History>,
     /// The pairs, in the order their accumulators are declared.
     pub pairs: Vec<Paired>,
     /// The histories summed alone.
@@ -139,7 +143,8 @@ pub(super) struct GroupPlan {
     pub stores: Vec<(usize, (Operand, Operand))>,
 }
 
-/// A transform's plan: each group's, and how many lanes it uses.
+/// A transform's plan: each group's, in the order its function runs them
+/// ([`groups`]), and how many lanes it uses.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub(super) struct Plan {
     pub groups: Vec<GroupPlan>,
@@ -150,8 +155,14 @@ pub(super) struct Plan {
 pub(super) fn plan(t: &Transform) -> Plan {
     let mut lanes = Vec::new();
     let groups = groups(t)
-        .iter()
-        .map(|group| assign(&of_group(t, group), &mut lanes))
+        .into_iter()
+        .map(|group| {
+            let histories = of_group(t, &group);
+            let mut plan = assign(&histories, &mut lanes);
+            plan.group = group;
+            plan.histories = histories;
+            plan
+        })
         .collect();
     Plan {
         groups,
