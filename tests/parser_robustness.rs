@@ -158,8 +158,12 @@ fn mutate(
     let mut runner = TestRunner::new(Config {
         cases,
         failure_persistence: None,
+        // A case that hangs leaves the engine busy on the worker thread:
+        // report it as it came, without running more cases to shrink it.
+        max_shrink_iters: 0,
         ..Config::default()
     });
+    let deriver = derive.then(Deriver::start);
     let strategy = (
         0..corpus.len(),
         proptest::collection::vec(mutation(), 1..=mutations),
@@ -188,22 +192,23 @@ fn mutate(
                 }
                 Ok(Ok(model)) => Some(model),
             };
-            if let (true, Some(model)) = (derive, model) {
-                let derived = std::panic::catch_unwind(|| {
-                    dalembert_codegen::derive::derive(&model)
-                        .map(|d| dalembert_codegen::emit::file(&d, Default::default()))
-                });
-                match derived {
-                    Err(_) => {
+            if let (Some(deriver), Some(model)) = (&deriver, model) {
+                match deriver.derive(model, limit) {
+                    Derived::Hung => {
+                        return Err(TestCaseError::fail(format!(
+                            "the derivation did not return within {limit:?} on:\n{text}"
+                        )));
+                    }
+                    Derived::Panicked => {
                         return Err(TestCaseError::fail(format!(
                             "the derivation panicked on:\n{text}"
                         )));
                     }
-                    Ok(Err(errors)) => {
+                    Derived::Errors(errors) => {
                         located(&errors, &text)?;
                         outcomes.borrow_mut().refused += 1;
                     }
-                    Ok(Ok(code)) => {
+                    Derived::Code(code) => {
                         prop_assert!(code.contains("@generated"));
                         outcomes.borrow_mut().generated += 1;
                     }
@@ -222,6 +227,57 @@ fn mutate(
         })
         .unwrap();
     outcomes.into_inner()
+}
+
+/// What the derivation of one case came to.
+enum Derived {
+    Code(String),
+    Errors(dalembert_codegen::ModelErrors),
+    Panicked,
+    /// No answer within the limit (the worker may still be computing).
+    Hung,
+}
+
+/// The derivation on a worker thread of its own, so that a case that never
+/// returns fails the test with its text instead of hanging it. One thread
+/// does every derivation: the symbolic engine is used from one thread only.
+struct Deriver {
+    cases: std::sync::mpsc::Sender<dalembert_codegen::ir::Model>,
+    answers: std::sync::mpsc::Receiver<Derived>,
+}
+
+impl Deriver {
+    fn start() -> Self {
+        let (cases, inbox) = std::sync::mpsc::channel::<dalembert_codegen::ir::Model>();
+        let (outbox, answers) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            for model in inbox {
+                let derived = std::panic::catch_unwind(|| {
+                    dalembert_codegen::derive::derive(&model)
+                        .map(|d| dalembert_codegen::emit::file(&d, Default::default()))
+                });
+                let answer = match derived {
+                    Err(_) => Derived::Panicked,
+                    Ok(Err(errors)) => Derived::Errors(errors),
+                    Ok(Ok(code)) => Derived::Code(code),
+                };
+                if outbox.send(answer).is_err() {
+                    break;
+                }
+            }
+        });
+        Self { cases, answers }
+    }
+
+    fn derive(&self, model: dalembert_codegen::ir::Model, limit: Duration) -> Derived {
+        self.cases.send(model).expect("the worker is alive");
+        match self.answers.recv_timeout(limit) {
+            Ok(answer) => answer,
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => Derived::Hung,
+            // The worker died outside its catch_unwind.
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => Derived::Panicked,
+        }
+    }
 }
 
 /// Every error has a line and column, and a span within the text.
