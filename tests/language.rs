@@ -262,6 +262,57 @@ surface = "x"
     );
 }
 
+/// exp(k·x) in every part of a model: the symbolic engine's exact
+/// arithmetic takes it for exp(x)^k, so k counts towards the degree limit
+/// (with k = 10⁵ or 10⁹ its exponents overflowed and the derivation
+/// panicked); within the limit the programs have the value it means.
+#[test]
+fn exp_of_a_multiple_is_bounded_as_a_power() {
+    let model = |k: &str| {
+        format!(
+            r#"
+[model]
+name = "exp_multiple"
+[coordinates]
+names = ["x", "z"]
+[dynamics]
+kinetic_energy = "(x_dot^2 + z_dot^2)/2"
+potential = "exp(-{k}*z) + z"
+[[wall]]
+name = "floor"
+surface = "z - exp(300*x)/2"
+contact = ["x_dot*exp(2*z) - z_dot"]
+"#
+        )
+    };
+    for k in ["100000", "999999999", "1/0.00001"] {
+        let text = model(k);
+        let errors = with_model_file("exp_multiple", &text, |path| {
+            dalembert_codegen::derive(path).expect_err(k)
+        });
+        let message = errors.to_string();
+        assert!(
+            message.contains("polynomial degree") && message.contains(":8:"),
+            "{k}: {message}"
+        );
+    }
+    let d = derive("exp_multiple", &model("40"));
+    let (x, z) = (1e-3, 0.25);
+    let inputs = [x, z, 0.0, 0.0];
+    close(
+        "V",
+        eval(&d, Quantity::Potential, &inputs)[0],
+        (-40.0f64 * z).exp() + z,
+        1e-15,
+    );
+    close(
+        "f",
+        wall_eval(&d, 0, Quantity::Surface, &inputs)[0],
+        z - (300.0 * x).exp() / 2.0,
+        1e-15,
+    );
+}
+
 /// Names symbolica gives meanings of its own are plain names in a model.
 #[test]
 fn the_symbolic_engines_own_names_are_plain_names() {

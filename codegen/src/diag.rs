@@ -72,6 +72,16 @@ pub enum ErrorKind {
     /// A velocity-level constraint is not linear in the velocities.
     #[error("this constraint is not linear in the velocities: {0}")]
     NotLinear(String),
+    /// A velocity occurs other than polynomially.
+    #[error(
+        "`{name}` depends on the velocities and is {place}: velocities may occur only in sums, products and whole non-negative powers (the kinetic energy is a quadratic form in them, every constraint row linear)"
+    )]
+    VelocityNotPolynomial {
+        /// The velocity, or the definition that depends on one.
+        name: String,
+        /// Where it occurs, in words.
+        place: String,
+    },
     /// The potential depends on velocities.
     #[error("the potential depends on the velocity `{0}`")]
     VelocityInPotential(String),

@@ -291,6 +291,7 @@ pub fn parse(path: &Path, text: &str) -> Result<Model, ModelErrors> {
     if let Some(m) = &model {
         check_names(m, &mut cx);
         check_degrees(m, &mut cx);
+        check_polynomial_in_velocities(m, &mut cx);
     }
     match model {
         Some(m) => cx.finish(m),
@@ -340,6 +341,31 @@ fn check_degrees(model: &Model, cx: &mut Collector) {
                     expr::MAX_DEGREE
                 )),
                 Some(e.span.clone()),
+            );
+        }
+    }
+}
+
+/// Reports every expression in which a velocity (or a definition that
+/// depends on one) occurs inside a function, in a divisor or under a
+/// fractional or negative power. T must be a quadratic form in the
+/// velocities and every constraint row linear in them, so they can only
+/// occur in sums, products and whole powers; the derivation's exact checks
+/// of those degrees then stay polynomial arithmetic (a velocity under a
+/// power such as 41/2 kept the symbolic engine busy without end).
+fn check_polynomial_in_velocities(model: &Model, cx: &mut Collector) {
+    let mut varies: std::collections::HashSet<&str> =
+        model.velocities.iter().map(String::as_str).collect();
+    for (name, e) in &model.definitions {
+        if e.node.depends(&|n| varies.contains(n)) {
+            varies.insert(name);
+        }
+    }
+    for e in model.expressions() {
+        if let Some((span, name, place)) = e.node.non_polynomial(&|n| varies.contains(n)) {
+            cx.error(
+                ErrorKind::VelocityNotPolynomial { name, place },
+                Some(e.at(&span)),
             );
         }
     }

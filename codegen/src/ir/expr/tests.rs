@@ -85,3 +85,42 @@ fn numbers_do_not_wrap_around() {
     );
     assert!(parse(&"9".repeat(400)).is_err());
 }
+
+/// Where a varying name stops being polynomial: inside a function, in a
+/// divisor, under a fractional or negative power; whole powers, sums,
+/// products and other names' functions are polynomial.
+#[test]
+fn non_polynomial_uses_are_found_where_they_are() {
+    let v = |n: &str| n == "v" || n == "w";
+    let place = |s: &str| ok(s).non_polynomial(&v);
+    for s in [
+        "v^2*sin(x) + 3*w*v/m - (v + x)^3",
+        "x^(1/2)*v",
+        "-v^0",
+        "exp(x)/y",
+    ] {
+        assert_eq!(place(s), None, "{s}");
+    }
+    for (s, span, name, where_) in [
+        ("m/2*(x + v^(41/2))", 9..17, "v", "raised to the power 41/2"),
+        ("x*sin(2*w)", 2..10, "w", "inside sin(…)"),
+        ("x/(1 + v)", 2..9, "v", "in a divisor"),
+        ("(v*x)^-2", 0..8, "v", "raised to the power -2"),
+    ] {
+        assert_eq!(place(s), Some((span, name.into(), where_.into())), "{s}");
+    }
+    assert!(ok("x + sqrt(v)").depends(&v) && !ok("x + sqrt(y)").depends(&v));
+}
+
+/// exp(k·x) counts as the k-th power of one variable (the symbolic
+/// engine's exact arithmetic takes it so, and with k in the hundred
+/// thousands its exponents overflowed); other functions as one variable.
+#[test]
+fn exp_of_a_multiple_counts_as_a_power() {
+    let one = |_: &str| 1;
+    assert_eq!(ok("exp(x)").degree(&one), 1);
+    assert_eq!(ok("exp(-300*x)").degree(&one), 300);
+    assert_eq!(ok("exp(x/0.00001)").degree(&one), 100_000);
+    assert_eq!(ok("exp(2*x*y)^3").degree(&one), 12);
+    assert_eq!(ok("sin(300*x)").degree(&one), 1);
+}

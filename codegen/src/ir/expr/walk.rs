@@ -65,9 +65,39 @@ impl Node {
         }
     }
 
+    /// The largest |numerator| or denominator of a number in the tree (at
+    /// least 1; a denominator counts too, so that exp(x/0.00001) is bounded
+    /// as exp(100000·x) is).
+    fn largest_number(&self) -> u64 {
+        let mut largest = 1u64;
+        let mut walk = |n: &Node| {
+            if let NodeKind::Number(r) = &n.kind {
+                let size = r.num.unsigned_abs().max(r.den.unsigned_abs());
+                largest = largest.max(size.min(u64::MAX as u128) as u64);
+            }
+        };
+        self.visit(&mut walk);
+        largest
+    }
+
+    /// Calls `f` on every node of the tree.
+    fn visit(&self, f: &mut dyn FnMut(&Node)) {
+        f(self);
+        match &self.kind {
+            NodeKind::Name(_) | NodeKind::Number(_) | NodeKind::Constant(_) => {}
+            NodeKind::Sum(items) | NodeKind::Product(items) => {
+                for (_, x) in items {
+                    x.visit(f);
+                }
+            }
+            NodeKind::Neg(x) | NodeKind::Pow(x, _) | NodeKind::Call(_, x) => x.visit(f),
+        }
+    }
+
     /// An upper bound on the polynomial degree, each name of degree
     /// `degree(name)` (a function application counts as a new variable of
-    /// the degree of its argument). Saturating.
+    /// the degree of its argument; exp(k·x) as the k-th power of one, as
+    /// the symbolic engine's exact arithmetic takes it). Saturating.
     pub fn degree(&self, degree: &dyn Fn(&str) -> u64) -> u64 {
         match &self.kind {
             NodeKind::Name(n) => degree(n),
@@ -81,10 +111,59 @@ impl Node {
                 .iter()
                 .fold(0u64, |acc, (_, x)| acc.saturating_add(x.degree(degree))),
             NodeKind::Neg(x) => x.degree(degree),
+            // Exact arithmetic takes exp(k·x) for exp(x)^k: k multiplies.
+            NodeKind::Call(Function::Exp, x) => {
+                x.degree(degree).max(1).saturating_mul(x.largest_number())
+            }
             NodeKind::Call(_, x) => x.degree(degree).max(1),
             NodeKind::Pow(x, n) => x
                 .degree(degree)
                 .saturating_mul(n.num.unsigned_abs().min(u64::MAX as u128) as u64),
+        }
+    }
+
+    /// Whether a name for which `varies` holds occurs in the tree.
+    pub fn depends(&self, varies: &dyn Fn(&str) -> bool) -> bool {
+        let mut found = false;
+        self.visit_names(&mut |n, _| found |= varies(n));
+        found
+    }
+
+    /// The first place where a name for which `varies` holds occurs other
+    /// than in sums, products and powers with whole non-negative exponents:
+    /// inside a function, in a divisor, or in the base of a fractional or
+    /// negative power. Returns that node's span, the name and the place in
+    /// words; `None` where the tree is a polynomial in those names.
+    pub fn non_polynomial(
+        &self,
+        varies: &dyn Fn(&str) -> bool,
+    ) -> Option<(Range<usize>, String, String)> {
+        let first = |x: &Node| {
+            let mut name = None;
+            x.visit_names(&mut |n, _| {
+                if name.is_none() && varies(n) {
+                    name = Some(n.to_string());
+                }
+            });
+            name
+        };
+        match &self.kind {
+            NodeKind::Name(_) | NodeKind::Number(_) | NodeKind::Constant(_) => None,
+            NodeKind::Sum(items) => items.iter().find_map(|(_, x)| x.non_polynomial(varies)),
+            NodeKind::Product(items) => items.iter().find_map(|(divide, x)| match first(x) {
+                Some(name) if *divide => Some((x.span.clone(), name, "in a divisor".into())),
+                _ => x.non_polynomial(varies),
+            }),
+            NodeKind::Neg(x) => x.non_polynomial(varies),
+            NodeKind::Pow(x, n) => match first(x) {
+                Some(name) if n.den != 1 || n.num < 0 => {
+                    Some((self.span.clone(), name, format!("raised to the power {n}")))
+                }
+                _ => x.non_polynomial(varies),
+            },
+            NodeKind::Call(f, x) => {
+                first(x).map(|name| (self.span.clone(), name, format!("inside {}(…)", f.name())))
+            }
         }
     }
 }
