@@ -64,6 +64,13 @@ const FRAGMENTS: &[&str] = &[
     "#",
     "\t",
     "99999999999999999999999",
+    // Ways into the symbolic engine's exact arithmetic that once hung or
+    // panicked the derivation: a velocity under a fractional power, exp of
+    // a large multiple.
+    "^20.5",
+    "exp(",
+    "sqrt(",
+    "999999999*",
 ];
 
 #[derive(Debug, Clone)]

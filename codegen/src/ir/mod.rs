@@ -351,8 +351,9 @@ fn check_degrees(model: &Model, cx: &mut Collector) {
 /// fractional or negative power. T must be a quadratic form in the
 /// velocities and every constraint row linear in them, so they can only
 /// occur in sums, products and whole powers; the derivation's exact checks
-/// of those degrees then stay polynomial arithmetic (a velocity under a
-/// power such as 41/2 kept the symbolic engine busy without end).
+/// of those degrees then stay polynomial arithmetic (with a definition of
+/// the velocities raised to the power 41/2 in T, the derivation had not
+/// returned after 90 s).
 fn check_polynomial_in_velocities(model: &Model, cx: &mut Collector) {
     let mut varies: std::collections::HashSet<&str> =
         model.velocities.iter().map(String::as_str).collect();
