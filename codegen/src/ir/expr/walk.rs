@@ -69,28 +69,18 @@ impl Node {
     /// least 1; a denominator counts too, so that exp(x/0.00001) is bounded
     /// as exp(100000·x) is).
     fn largest_number(&self) -> u64 {
-        let mut largest = 1u64;
-        let mut walk = |n: &Node| {
-            if let NodeKind::Number(r) = &n.kind {
-                let size = r.num.unsigned_abs().max(r.den.unsigned_abs());
-                largest = largest.max(size.min(u64::MAX as u128) as u64);
-            }
-        };
-        self.visit(&mut walk);
-        largest
-    }
-
-    /// Calls `f` on every node of the tree.
-    fn visit(&self, f: &mut dyn FnMut(&Node)) {
-        f(self);
         match &self.kind {
-            NodeKind::Name(_) | NodeKind::Number(_) | NodeKind::Constant(_) => {}
-            NodeKind::Sum(items) | NodeKind::Product(items) => {
-                for (_, x) in items {
-                    x.visit(f);
-                }
+            NodeKind::Number(r) => {
+                let size = r.num.unsigned_abs().max(r.den.unsigned_abs());
+                size.clamp(1, u64::MAX as u128) as u64
             }
-            NodeKind::Neg(x) | NodeKind::Pow(x, _) | NodeKind::Call(_, x) => x.visit(f),
+            NodeKind::Name(_) | NodeKind::Constant(_) => 1,
+            NodeKind::Sum(items) | NodeKind::Product(items) => items
+                .iter()
+                .map(|(_, x)| x.largest_number())
+                .max()
+                .unwrap_or(1),
+            NodeKind::Neg(x) | NodeKind::Pow(x, _) | NodeKind::Call(_, x) => x.largest_number(),
         }
     }
 
@@ -124,9 +114,18 @@ impl Node {
 
     /// Whether a name for which `varies` holds occurs in the tree.
     pub fn depends(&self, varies: &dyn Fn(&str) -> bool) -> bool {
-        let mut found = false;
-        self.visit_names(&mut |n, _| found |= varies(n));
-        found
+        self.first_name(varies).is_some()
+    }
+
+    /// The first name in the tree for which `varies` holds.
+    fn first_name(&self, varies: &dyn Fn(&str) -> bool) -> Option<String> {
+        let mut name = None;
+        self.visit_names(&mut |n, _| {
+            if name.is_none() && varies(n) {
+                name = Some(n.to_string());
+            }
+        });
+        name
     }
 
     /// The first place where a name for which `varies` holds occurs other
@@ -138,15 +137,7 @@ impl Node {
         &self,
         varies: &dyn Fn(&str) -> bool,
     ) -> Option<(Range<usize>, String, String)> {
-        let first = |x: &Node| {
-            let mut name = None;
-            x.visit_names(&mut |n, _| {
-                if name.is_none() && varies(n) {
-                    name = Some(n.to_string());
-                }
-            });
-            name
-        };
+        let first = |x: &Node| x.first_name(varies);
         match &self.kind {
             NodeKind::Name(_) | NodeKind::Number(_) | NodeKind::Constant(_) => None,
             NodeKind::Sum(items) => items.iter().find_map(|(_, x)| x.non_polynomial(varies)),
