@@ -22,25 +22,27 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         let k = located.wall;
         let step = located.t_hi - t0;
         let (tc, y) = self.polish(method, y0, t0, located)?;
-        let collision = self.land(k, (tc, 0.0), &y, t0, step)?;
+        let settings = self.settings;
+        let window = || settings.simultaneity_window(tc, step);
+        let collision = self.land(k, (tc, 0.0), &y, t0, window)?;
         self.f0 = self.rhs(tc, &self.phase())?;
         Ok(collision)
     }
 
-    /// The collision with wall `k` at (tc, y), found on a step of length
-    /// `step` from t0: checked, mapped, and the simulator's state set to
-    /// just after it (projected onto the constraints). `tc` comes with its
-    /// rounding term (the compensated clock of Taylor's method, zero
-    /// otherwise), which becomes the clock's with the state.
+    /// The collision with wall `k` at (tc, y), found on a step from t0:
+    /// checked, mapped, and the simulator's state set to just after it
+    /// (projected onto the constraints). `tc` comes with its rounding term
+    /// (the compensated clock of Taylor's method, zero otherwise), which
+    /// becomes the clock's with the state. `window` gives the
+    /// simultaneity window of the step (see [`Simulator::resolve`]).
     pub(super) fn land(
         &mut self,
         k: usize,
         (tc, t_low): (f64, f64),
         y: &Phase<N>,
         t0: f64,
-        step: f64,
+        window: impl FnMut() -> f64,
     ) -> Result<Collision<M::Wall, N>, SimError<M::Wall>> {
-        let window = self.settings.simultaneity_window(tc, step);
         let collision = self.resolve(k, tc, y, window)?;
         self.state = State {
             t: tc,
@@ -121,13 +123,16 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
 
     /// The collision with wall `k` at (tc, y): refused when grazing, when
     /// the map does not reverse the normal velocity (B loses rank there) or
-    /// when another wall is met within `window` of tc.
+    /// when another wall is met within the simultaneity window of tc (which
+    /// `window` gives, called only where there is another wall: for
+    /// Taylor's method it may take the step's length, not otherwise
+    /// needed).
     fn resolve(
         &self,
         k: usize,
         tc: f64,
         y: &Phase<N>,
-        window: f64,
+        mut window: impl FnMut() -> f64,
     ) -> Result<Collision<M::Wall, N>, SimError<M::Wall>> {
         let m = self.model;
         let wall = m.walls()[k];
@@ -147,10 +152,12 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         }
         // Another wall at or beyond reach within the window, moving as after
         // this collision?
+        let mut within = None;
         for (j, &other) in m.walls().iter().enumerate() {
             if j == k {
                 continue;
             }
+            let window = *within.get_or_insert_with(&mut window);
             let rate = m.normal_velocity(other, &y.q, &v_plus).min(0.0);
             if m.surface(other, &y.q) + window * rate <= 0.0 {
                 return Err(SimError::Simultaneous {

@@ -374,3 +374,15 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
         }
     }
 }
+
+/// Numbers uniform in [0, 1) from a xorshift generator: the unit tests'
+/// random cases, the same on every run.
+#[cfg(test)]
+pub(crate) fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+    move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+}

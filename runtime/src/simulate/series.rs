@@ -6,7 +6,7 @@
 //! the step's polynomial there, so a collision costs no further steps.
 
 use super::dense_output::LastStep;
-use super::integrator::Plan;
+use super::integrator::{Plan, Reach};
 use super::phase::Phase;
 use super::thresholds::{SERIES_ROOT_ITERATIONS, SERIES_SAMPLES, step_too_small};
 use super::{SimError, Simulator, State, Step};
@@ -44,8 +44,9 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     /// series is computed again to the full order, and the lower order is
     /// raised (from [`Taylor::FIRST_TRIAL_ORDER`] up to the full order,
     /// where the trials stop) to the lowest order whose own step, read off
-    /// the same coefficients ([`Plan::step_at`]), reaches as far as the full
-    /// one went: to the wall it meets at τ, else to the end of its step. So
+    /// the same coefficients ([`Plan::reach`], [`Plan::covers`]), reaches as
+    /// far as the full one went: to the wall it meets at τ, else to the end
+    /// of its step. So
     /// each run learns from its first flight the lowest order its flights
     /// need, and again, in one trial, each time a flight needs more; a
     /// motion whose steps the radius of convergence bounds (where no lower
@@ -65,33 +66,46 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         let left = (t_end - t0) - self.t_low;
         let tried = self.low_order_first && self.low_order < method.order;
         if tried {
-            let h = self.series(method, self.low_order, left)?;
-            let found = self.first_collision(h)?;
-            if found.is_some() || h >= left {
+            let mut limit = self.series(method, self.low_order, left)?;
+            let found = self.first_collision(&mut limit)?;
+            if found.is_some() || limit.length(t0)? >= left {
                 self.stats.low_order_steps += 1;
-                return self.take(h, t_end, found);
+                return self.take(&mut limit, t_end, found);
             }
         }
-        let h = self.series(method, method.order, left)?;
+        let mut limit = self.series(method, method.order, left)?;
+        let h = limit.length(t0)?;
         // The Runge–Kutta steps' rule (a fixed order far below the
         // tolerance's steps by about ε/‖q̇‖ at order 2).
         if step_too_small(h, t0) && h < left {
             return Err(SimError::StepTooSmall { t: t0, step: h });
         }
-        let found = self.first_collision(h)?;
+        let found = self.first_collision(&mut limit)?;
         if tried {
             let reach = found.map_or(h, |(_, tau)| tau);
             self.low_order = (self.low_order + 1..method.order)
-                .find(|&p| method.step_at(&self.series, p) >= reach)
+                .find(|&p| method.covers(&method.reach(&self.series, p), reach))
                 .unwrap_or(method.order);
         }
         self.low_order_first = found.is_some();
-        self.take(h, t_end, found)
+        self.take(&mut limit, t_end, found)
     }
 
     /// The series of the motion from the current state to `order`, into
-    /// `self.series`, and the step on it (at most `left`).
-    fn series(&mut self, method: &Plan, order: usize, left: f64) -> Result<f64, SimError<M::Wall>> {
+    /// `self.series`, and the step it allows (at most `left`).
+    fn series<'p>(
+        &mut self,
+        method: &'p Plan,
+        order: usize,
+        left: f64,
+    ) -> Result<Limit<'p>, SimError<M::Wall>> {
+        // NaN fails too.
+        if left.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
+            return Err(SimError::StepTooSmall {
+                t: self.state.t,
+                step: left,
+            });
+        }
         let s = &mut self.series;
         s.restart(&self.state.q, &self.state.v);
         if !self.model.taylor_series(s, &mut self.scratch, order) {
@@ -103,20 +117,21 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         // (`finite` below): Horner's scheme carries an infinity or a NaN in
         // any coefficient into the value at any τ > 0, so checking the 2N
         // values there costs far less than checking every coefficient.
-        let h = method.step(s).min(left);
-        // NaN fails too.
-        if h.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
-            return Err(SimError::StepTooSmall {
-                t: self.state.t,
-                step: h,
-            });
-        }
-        Ok(h)
+        Ok(Limit {
+            plan: method,
+            reach: method.reach(s, order),
+            left,
+            length: None,
+        })
     }
 
-    /// The first collision on the step of length h along `self.series`:
-    /// the wall's index and τ; grazing and simultaneous contacts as errors.
-    fn first_collision(&mut self, h: f64) -> Result<Option<(usize, f64)>, SimError<M::Wall>> {
+    /// The first collision on the step `limit` allows along
+    /// `self.series`: the wall's index and τ; grazing and simultaneous
+    /// contacts as errors.
+    fn first_collision(
+        &mut self,
+        limit: &mut Limit,
+    ) -> Result<Option<(usize, f64)>, SimError<M::Wall>> {
         let (t0, m, s) = (self.state.t, self.model, &self.series);
         let scratch = &mut self.scratch;
         let mut best: Option<(usize, f64)> = None;
@@ -125,7 +140,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         for (k, &wall) in m.walls().iter().enumerate() {
             m.surface_series(wall, s, scratch, &mut f);
             let departing = self.departing & (1 << k) != 0;
-            let tau = match first_root(&f, s.order, h, departing) {
+            let tau = match limit.first_root(&f, s.order, departing, t0)? {
                 Ok(Some(tau)) => tau,
                 Ok(None) => continue,
                 Err(top) => {
@@ -145,19 +160,20 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             }
         }
         if let (Some((k, a)), Some(b)) = (best, second)
-            && b - a <= self.settings.simultaneity_window(t0 + a, h)
+            && b - a <= self.settings.simultaneity_window(t0 + a, limit.length(t0)?)
         {
-            let other = m
-                .walls()
-                .iter()
-                .enumerate()
-                .find(|(j, w)| {
-                    *j != k && {
-                        m.surface_series(**w, s, scratch, &mut f);
-                        first_root(&f, s.order, h, self.departing & (1 << j) != 0) == Ok(Some(b))
-                    }
-                })
-                .map_or(m.walls()[k], |(_, w)| *w);
+            let mut other = m.walls()[k];
+            for (j, &w) in m.walls().iter().enumerate() {
+                if j == k {
+                    continue;
+                }
+                m.surface_series(w, s, scratch, &mut f);
+                let departing = self.departing & (1 << j) != 0;
+                if limit.first_root(&f, s.order, departing, t0)? == Ok(Some(b)) {
+                    other = w;
+                    break;
+                }
+            }
             return Err(SimError::Simultaneous {
                 first: m.walls()[k],
                 second: other,
@@ -167,16 +183,16 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         Ok(best)
     }
 
-    /// The step along `self.series`: to the collision `found`, else by h
-    /// (to `t_end` if h reaches it).
+    /// The step along `self.series`: to the collision `found`, else as
+    /// far as `limit` allows (to `t_end` if that reaches it).
     fn take(
         &mut self,
-        h: f64,
+        limit: &mut Limit,
         t_end: f64,
         found: Option<(usize, f64)>,
     ) -> Result<Step<M::Wall, N>, SimError<M::Wall>> {
         let t0 = self.state.t;
-        let left = (t_end - t0) - self.t_low;
+        let left = limit.left;
         self.stats.steps += 1;
         let t0_low = self.t_low;
         let last = |stop| LastStep {
@@ -189,12 +205,15 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             Some((k, tau)) => {
                 let (q, v) = finite(self.series.state(tau), t0)?;
                 let tc = self.time_after(tau);
-                let collision = self.land(k, tc, &Phase { q, v }, t0, h)?;
+                let settings = self.settings;
+                let window = || settings.simultaneity_window(tc.0, limit.length_or_nan());
+                let collision = self.land(k, tc, &Phase { q, v }, t0, window)?;
                 self.last = Some(last(tc.0));
                 self.stats.collisions += 1;
                 Ok(self.report(t0, Some(collision)))
             }
             None => {
+                let h = limit.length(t0)?;
                 let (q, v) = finite(self.series.state(h), t0)?;
                 let (t1, low) = if h >= left {
                     (t_end, 0.0)
@@ -228,6 +247,70 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     }
 }
 
+/// How far a step on a series may go: within the tolerance (the
+/// [`Reach`] of its [`Plan`]) and the run's end (`left`). Its length,
+/// Jorba & Zou's estimate, takes two logarithms and an exponential, so it
+/// is computed only where a step needs it: whether a collision's instant is
+/// within the step is decided without them ([`Plan::covers`]), and a
+/// polynomial of degree 2 or less is searched for roots exactly on any
+/// window ([`first_root`]), so a cheap window at least as long as the step
+/// ([`Plan::beyond`]) serves. A flight's f is of that kind, and its step
+/// ends at the wall.
+struct Limit<'p> {
+    plan: &'p Plan,
+    reach: Reach,
+    left: f64,
+    length: Option<f64>,
+}
+
+impl Limit<'_> {
+    /// The step's length, at most `left`; positive, else the step is too
+    /// small (a NaN or an infinite coefficient among the last two).
+    fn length<W>(&mut self, t: f64) -> Result<f64, SimError<W>> {
+        let h = self.length_or_nan();
+        // NaN fails too.
+        if h.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
+            return Err(SimError::StepTooSmall { t, step: h });
+        }
+        Ok(h)
+    }
+
+    /// The step's length, at most `left`, unchecked.
+    fn length_or_nan(&mut self) -> f64 {
+        let (plan, reach, left) = (self.plan, &self.reach, self.left);
+        *self
+            .length
+            .get_or_insert_with(|| plan.length(reach).min(left))
+    }
+
+    /// Whether τ is within the step.
+    fn covers(&self, tau: f64) -> bool {
+        tau <= self.left && self.plan.covers(&self.reach, tau)
+    }
+
+    /// [`first_root`] of `c` (of `order`) on this step, from t.
+    fn first_root<W>(
+        &mut self,
+        c: &Coefficients,
+        order: usize,
+        departing: bool,
+        t: f64,
+    ) -> Result<Result<Option<f64>, f64>, SimError<W>> {
+        // Trailing zeros cost evaluations and say nothing (a flight's f is
+        // often of degree 2).
+        let order = degree(c, order);
+        let window = self.plan.beyond(&self.reach).min(self.left);
+        if order > 2 || window == f64::INFINITY {
+            return Ok(first_root(c, order, self.length(t)?, departing));
+        }
+        Ok(match first_root(c, order, window, departing) {
+            Ok(Some(tau)) if !self.covers(tau) => Ok(None),
+            Err(top) if !self.covers(top) => Ok(None),
+            found => found,
+        })
+    }
+}
+
 /// The state on the step's polynomial, if finite (a non-finite series
 /// gives a non-finite state at every τ > 0).
 fn finite<W, const N: usize>(
@@ -244,15 +327,15 @@ fn finite<W, const N: usize>(
     }
 }
 
-/// The first τ in (0, h] where the polynomial f (of `order`) falls to zero
-/// from above, if any; `departing` when the wall was just left (f(0) ≈ 0
-/// rising): then a root at the start is the departure, not a collision.
-/// `Err(τ)`: the motion turns back towards the wall at τ before f was
-/// seen positive (grazing on departure).
+/// The first τ in (0, h] where the polynomial f (of `order`, its degree:
+/// see [`degree`]) falls to zero from above, if any; `departing` when the
+/// wall was just left (f(0) ≈ 0 rising): then a root at the start is the
+/// departure, not a collision. `Err(τ)`: the motion turns back towards the
+/// wall at τ before f was seen positive (grazing on departure). For a
+/// degree of 2 or less the answer on (0, h] is the answer on any longer
+/// window (g ≥ h) less what it finds beyond h: such an f turns at most
+/// once, so one sample at the window's end settles it.
 fn first_root(c: &Coefficients, order: usize, h: f64, departing: bool) -> Result<Option<f64>, f64> {
-    // Trailing zeros cost evaluations and say nothing (a flight's f is
-    // often of degree 2).
-    let order = degree(c, order);
     // f's turning point in [a, b] (needed after every bounce, where the
     // departure is followed over the top): for a parabola c₀ + c₁τ + c₂τ²
     // its vertex −c₁/(2c₂), else a root of f's derivative, made on demand.
@@ -460,5 +543,53 @@ mod tests {
         // Bottom just above 0.
         let c = poly(&[0.53 * 0.53 + 1e-8, -1.06, 1.0]);
         assert_eq!(first_root(&c, 2, 1.0, false), Ok(None));
+    }
+
+    /// For a degree of 2 or less, the search on a longer window, less what
+    /// it finds beyond the step, is the search on the step (what
+    /// [`Limit::first_root`] relies on): random parabolas and lines, rising
+    /// from the wall or not, steps and windows from 1e-3 to 10³.
+    #[test]
+    fn longer_windows_find_the_same_roots() {
+        let mut uniform = crate::simulate::uniform(0x9e37_79b9_7f4a_7c15u64);
+        let mut found = [0; 3];
+        for case in 0..20_000 {
+            let mut coefficient =
+                || (2.0 * uniform() - 1.0) * libm::pow(10.0, 2.0 * uniform() - 1.0);
+            let (c0, c1, c2) = (coefficient(), coefficient(), coefficient());
+            let departing = case % 2 == 0;
+            // Half of the departures from the wall itself.
+            let c0 = if departing && case % 4 == 0 {
+                -c0.abs() * 1e-9
+            } else {
+                c0
+            };
+            let c = poly(&[c0, c1, c2]);
+            let order = degree(&c, if case % 7 == 0 { 1 } else { 2 });
+            let h = libm::pow(10.0, 6.0 * uniform() - 3.0);
+            let g = h * libm::pow(10.0, 3.0 * uniform());
+            let on_step = first_root(&c, order, h, departing);
+            let on_window = match first_root(&c, order, g, departing) {
+                Ok(Some(tau)) if tau > h => Ok(None),
+                Err(top) if top > h => Ok(None),
+                other => other,
+            };
+            let same = match (on_step, on_window) {
+                (Ok(Some(a)), Ok(Some(b))) | (Err(a), Err(b)) => {
+                    (a - b).abs() <= 4.0 * f64::EPSILON * a.abs()
+                }
+                (a, b) => a == b,
+            };
+            assert!(
+                same,
+                "{c:?} {order} h {h} g {g} {departing}: {on_step:?} {on_window:?}"
+            );
+            found[match on_step {
+                Ok(Some(_)) => 0,
+                Ok(None) => 1,
+                Err(_) => 2,
+            }] += 1;
+        }
+        assert!(found.iter().all(|&n| n > 100), "{found:?}");
     }
 }

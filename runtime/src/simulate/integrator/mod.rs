@@ -17,8 +17,8 @@ mod taylor;
 pub(crate) use dense::Dense;
 pub use dopri::DormandPrince;
 pub use rk4::Rk4;
-pub(crate) use taylor::Plan;
 pub use taylor::Taylor;
+pub(crate) use taylor::{Plan, Reach};
 
 use super::phase::Phase;
 

@@ -7,7 +7,7 @@
 
 use crate::libm;
 use crate::simulate::thresholds::SERIES_SAMPLES;
-use crate::taylor::{MAX_ORDER, Series, SeriesWork};
+use crate::taylor::{CAPACITY, MAX_ORDER, Series, SeriesWork};
 
 /// A step's work besides the series of the motion and of the walls, the
 /// state on the step and the root search's samples, in multiply-adds, for
@@ -200,8 +200,13 @@ impl Plan {
     /// series was computed to, so a longer series tells what a shorter one
     /// would have done.
     pub fn step_at<const N: usize>(&self, s: &Series<N>, p: usize) -> f64 {
-        // ‖x₀‖∞, ‖x_{p−1}‖∞ and ‖xₚ‖∞ in one pass; a NaN is passed over
-        // (the state evaluated on the step catches it).
+        self.length(&self.reach(s, p))
+    }
+
+    /// What the step estimates read off the series `s` truncated at order
+    /// p (2 ≤ p ≤ `s.order`): ‖x₀‖∞, ‖x_{p−1}‖∞ and ‖xₚ‖∞, in one pass; a
+    /// NaN is passed over (the state evaluated on the step catches it).
+    pub fn reach<const N: usize>(&self, s: &Series<N>, p: usize) -> Reach {
         let mut norms = [0.0f64; 3];
         for i in 0..N {
             for (m, j) in norms.iter_mut().zip([0, p - 1, p]) {
@@ -212,7 +217,15 @@ impl Plan {
                 }
             }
         }
-        let scale = norms[0].max(1.0);
+        Reach {
+            p,
+            scale: norms[0].max(1.0),
+            last: [norms[1], norms[2]],
+        }
+    }
+
+    /// The step's length (see [`Taylor::step`]).
+    pub fn length(&self, r: &Reach) -> f64 {
         let (log_eps, asymptotic) = (self.log_tolerance, self.log_asymptotic);
         // In logarithms: ln h = ln ρⱼ + min(ln ε / j, −2) − 0.7/(p − 1)
         // (without the −2 at a fixed order), a logarithm per order read and
@@ -222,21 +235,135 @@ impl Plan {
                 f64::INFINITY
             } else {
                 let j = j as f64;
-                libm::log(scale / x) / j + (log_eps / j).min(asymptotic)
+                libm::log(r.scale / x) / j + (log_eps / j).min(asymptotic)
             }
         };
-        let log_h = log_step(p - 1, norms[1]).min(log_step(p, norms[2]));
+        let p = r.p;
+        let log_h = log_step(p - 1, r.last[0]).min(log_step(p, r.last[1]));
         if log_h == f64::INFINITY {
             return self.method.max_step;
         }
         libm::exp(log_h - 0.7 / (p - 1) as f64).min(self.method.max_step)
     }
+
+    /// Whether τ ≥ 0 is within the step, τ ≤ [`Plan::length`], decided
+    /// without its logarithms and exponential: for each j ∈ {p − 1, p},
+    /// τ ≤ hⱼ is ‖xⱼ‖ (τ e^(0.7/(p−1)))ʲ ≤ max(1, ‖x₀‖) ε, and where the
+    /// asymptotic bound applies also ‖xⱼ‖ (τ e^(0.7/(p−1)))ʲ e²ʲ ≤
+    /// max(1, ‖x₀‖). Where the power leaves the normal range of f64 the
+    /// length itself decides.
+    pub fn covers(&self, r: &Reach, tau: f64) -> bool {
+        if tau.is_nan() || tau > self.method.max_step {
+            return false;
+        }
+        if tau == 0.0 {
+            return true;
+        }
+        let p = r.p;
+        let u = tau * UNSAFETY[p];
+        let below = powi(u, p - 1);
+        for (j, x, power) in [(p - 1, r.last[0], below), (p, r.last[1], below * u)] {
+            if x == 0.0 {
+                continue;
+            }
+            if !(f64::MIN_POSITIVE..f64::INFINITY).contains(&power) {
+                return tau <= self.length(r);
+            }
+            // x is positive (NaN is passed over in the norms), so the term
+            // is a number or +∞.
+            let term = x * power;
+            if term > r.scale * self.method.tolerance {
+                return false;
+            }
+            if self.log_asymptotic < f64::INFINITY && term * E_2J[j] > r.scale {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// A length at least [`Plan::length`], without logarithms: the
+    /// truncation estimate of order p (or p − 1 where xₚ vanishes) without
+    /// the safety factor, rounded up to a power of two. Infinite where both
+    /// orders vanish, as the step is then (unless `max_step` bounds it).
+    pub fn beyond(&self, r: &Reach) -> f64 {
+        let (j, x) = if r.last[1] != 0.0 {
+            (r.p, r.last[1])
+        } else {
+            (r.p - 1, r.last[0])
+        };
+        if x == 0.0 {
+            return self.method.max_step;
+        }
+        let y = r.scale * self.method.tolerance / x;
+        if !(f64::MIN_POSITIVE..f64::INFINITY).contains(&y) {
+            return self.method.max_step;
+        }
+        // y < 2^(e+1), so y^(1/j) < 2^⌈(e+1)/j⌉.
+        let e = libm::ilogb(y) + 1;
+        let j = j as i32;
+        let k = -((-e).div_euclid(j));
+        libm::scalbn(1.0, k).min(self.method.max_step)
+    }
 }
+
+/// What [`Plan::length`] and [`Plan::covers`] read off a series truncated
+/// at order p.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Reach {
+    p: usize,
+    /// max(1, ‖x₀‖∞).
+    scale: f64,
+    /// ‖x_{p−1}‖∞ and ‖xₚ‖∞.
+    last: [f64; 2],
+}
+
+/// xⁿ by squaring.
+fn powi(mut x: f64, mut n: usize) -> f64 {
+    let mut acc = 1.0;
+    while n > 0 {
+        if n & 1 == 1 {
+            acc *= x;
+        }
+        x *= x;
+        n >>= 1;
+    }
+    acc
+}
+
+/// e^(0.7/(p − 1)) at order p (from 2), the inverse of the safety factor.
+const UNSAFETY: [f64; CAPACITY] = {
+    let mut t = [1.0; CAPACITY];
+    let mut p = 2;
+    while p < CAPACITY {
+        // Σ xᵏ/k! for x ≤ 0.7: 30 terms are exact to rounding.
+        let x = 0.7 / (p - 1) as f64;
+        let (mut term, mut sum, mut k) = (1.0, 1.0, 1);
+        while k < 30 {
+            term *= x / k as f64;
+            sum += term;
+            k += 1;
+        }
+        t[p] = sum;
+        p += 1;
+    }
+    t
+};
+
+/// e^(2j) for j up to [`MAX_ORDER`].
+const E_2J: [f64; CAPACITY] = {
+    let mut t = [1.0; CAPACITY];
+    let mut j = 1;
+    while j < CAPACITY {
+        t[j] = t[j - 1] * (core::f64::consts::E * core::f64::consts::E);
+        j += 1;
+    }
+    t
+};
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::taylor::CAPACITY;
 
     #[test]
     fn order_from_tolerance() {
@@ -373,5 +500,73 @@ mod tests {
         line.q[0][1] = 1.0;
         line.order = 20;
         assert_eq!(t.step(&line), f64::INFINITY);
+    }
+
+    /// Whether an instant is within the step, decided by powers, agrees
+    /// with the step's length from logarithms at every order, with and
+    /// without the asymptotic bound and a largest step, for norms from
+    /// 1e-30 to 1e30 and instants from 1e-6 to 10⁶ times the step (those
+    /// within 1e-12 of it either way, where rounding may decide, left
+    /// out); and the cheap window is never shorter than the step.
+    #[test]
+    fn covers_agrees_with_the_length() {
+        let mut uniform = crate::simulate::uniform(0x2545_f491_4f6c_dd1du64);
+        let plans = [
+            Plan::new(Taylor::default()),
+            Plan::new(Taylor {
+                fixed_order: Some(25),
+                ..Taylor::default()
+            }),
+            Plan::new(Taylor {
+                tolerance: 1e-10,
+                max_step: 0.3,
+                ..Taylor::default()
+            }),
+        ];
+        let mut checked = 0;
+        for plan in plans {
+            for p in 2..=MAX_ORDER {
+                for case in 0..40 {
+                    let mut norm = || libm::pow(10.0, 60.0 * uniform() - 30.0);
+                    let last = match case % 8 {
+                        0 => [0.0, norm()],
+                        1 => [norm(), 0.0],
+                        _ => [norm(), norm()],
+                    };
+                    let r = Reach {
+                        p,
+                        scale: 1.0f64.max(libm::pow(10.0, 4.0 * uniform())),
+                        last,
+                    };
+                    let h = plan.length(&r);
+                    assert!(plan.beyond(&r) >= h, "{r:?}: {h}");
+                    assert!(plan.covers(&r, 0.0));
+                    let tau = h * libm::pow(10.0, 12.0 * uniform() - 6.0);
+                    if (tau / h - 1.0).abs() < 1e-12 {
+                        continue;
+                    }
+                    assert_eq!(plan.covers(&r, tau), tau <= h, "{r:?}: τ {tau}, h {h}");
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 3000, "{checked}");
+        // Both last orders zero: every instant up to the largest step.
+        let r = Reach {
+            p: 10,
+            scale: 1.0,
+            last: [0.0, 0.0],
+        };
+        assert!(plans[0].covers(&r, 1e300));
+        assert!(plans[2].covers(&r, 0.3) && !plans[2].covers(&r, 0.31));
+        assert_eq!(plans[0].beyond(&r), f64::INFINITY);
+        // An infinite norm: no step.
+        let r = Reach {
+            p: 10,
+            scale: 1.0,
+            last: [f64::INFINITY, 1.0],
+        };
+        assert_eq!(plans[0].length(&r), 0.0);
+        assert!(!plans[0].covers(&r, 1e-300));
     }
 }
