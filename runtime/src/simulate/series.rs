@@ -46,15 +46,14 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     /// where the trials stop) to the lowest order whose own step, read off
     /// the same coefficients ([`Plan::reach`], [`Plan::covers`]), reaches as
     /// far as the full one went: to the wall it meets at τ, else to the end
-    /// of its step. So
-    /// each run learns from its first flight the lowest order its flights
-    /// need, and again, in one trial, each time a flight needs more; a
-    /// motion whose steps the radius of convergence bounds (where no lower
-    /// order steps as far) wastes one trial. A flight in uniform gravity is
-    /// the case in point: its motion is nearly polynomial, so a lower order
-    /// reaches the floor at a fraction of the cost (a parabola's at order
-    /// 4, where its last two terms vanish), and the cost of a series grows
-    /// as the square of its order.
+    /// of its step. So each run learns from its first flight the lowest
+    /// order its flights need, and again, in one trial, each time a flight
+    /// needs more; a motion whose steps the radius of convergence bounds
+    /// (where no lower order steps as far) wastes one trial. A flight in
+    /// uniform gravity is the case in point: its motion is nearly
+    /// polynomial, so a lower order reaches the floor at a fraction of the
+    /// cost (a parabola's at order 4, where its last two terms vanish), and
+    /// the cost of a series grows as the square of its order.
     ///
     /// [`Taylor::FIRST_TRIAL_ORDER`]: super::Taylor::FIRST_TRIAL_ORDER
     pub(super) fn series_step(
@@ -299,15 +298,17 @@ impl Limit<'_> {
         // Trailing zeros cost evaluations and say nothing (a flight's f is
         // often of degree 2).
         let order = degree(c, order);
-        let window = self.plan.beyond(&self.reach).min(self.left);
-        if order > 2 || window == f64::INFINITY {
-            return Ok(first_root(c, order, self.length(t)?, departing));
+        if order <= 2 {
+            let window = self.plan.beyond(&self.reach).min(self.left);
+            if window < f64::INFINITY {
+                return Ok(match first_root(c, order, window, departing) {
+                    Ok(Some(tau)) if !self.covers(tau) => Ok(None),
+                    Err(top) if !self.covers(top) => Ok(None),
+                    found => found,
+                });
+            }
         }
-        Ok(match first_root(c, order, window, departing) {
-            Ok(Some(tau)) if !self.covers(tau) => Ok(None),
-            Err(top) if !self.covers(top) => Ok(None),
-            found => found,
-        })
+        Ok(first_root(c, order, self.length(t)?, departing))
     }
 }
 
