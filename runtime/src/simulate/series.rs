@@ -458,7 +458,7 @@ fn quadratic_root(c: &Coefficients, order: usize, a: f64, b: f64) -> Option<f64>
     if d < 0.0 {
         return None;
     }
-    let q = -0.5 * (c1 + libm::copysign(libm::sqrt(d), c1));
+    let q = -0.5 * (c1 + libm::sqrt(d).copysign(c1));
     let first = q / c2;
     let second = if q == 0.0 { first } else { c0 / q };
     inside(first.min(second)).or_else(|| inside(first.max(second)))
