@@ -268,13 +268,33 @@ pub fn recip_finish(c: &Coefficients, a: &Coefficients, h: f64, k: usize) -> f64
 /// compiler keeps of 1/b₀ from one order to the next.
 #[inline(always)]
 pub fn div_finish(c: &Coefficients, a: &Coefficients, b: &Coefficients, h: f64, k: usize) -> f64 {
-    (a[k] - b[k] * c[0] - h) * (1.0 / b[0])
+    div_finish_by(c, a, b, h, k, 1.0 / b[0])
+}
+
+/// [`div_finish`] with its factor 1/b₀ given: generated code works it out
+/// once per series, at order 0, so no order repeats the division.
+#[inline(always)]
+pub fn div_finish_by(
+    c: &Coefficients,
+    a: &Coefficients,
+    b: &Coefficients,
+    h: f64,
+    k: usize,
+    inv_b0: f64,
+) -> f64 {
+    (a[k] - b[k] * c[0] - h) * inv_b0
 }
 
 /// Coefficient k ≥ 1 of c = √a from the [`history`] h of c with itself.
 #[inline(always)]
 pub fn sqrt_finish(c: &Coefficients, a: &Coefficients, h: f64, k: usize) -> f64 {
-    (a[k] - h) * (0.5 / c[0])
+    sqrt_finish_by(a, h, k, 0.5 / c[0])
+}
+
+/// [`sqrt_finish`] with its factor 1/(2c₀) given (see [`div_finish_by`]).
+#[inline(always)]
+pub fn sqrt_finish_by(a: &Coefficients, h: f64, k: usize, half_inv_c0: f64) -> f64 {
+    (a[k] - h) * half_inv_c0
 }
 
 /// Coefficient k ≥ 1 of c = a^α from its [`power_history`] h.
@@ -293,7 +313,13 @@ pub fn exp_finish(c: &Coefficients, a: &Coefficients, h: f64, k: usize) -> f64 {
 /// a.
 #[inline(always)]
 pub fn log_finish(a: &Coefficients, h: f64, k: usize) -> f64 {
-    (a[k] - h * RECIPROCALS[k]) * (1.0 / a[0])
+    log_finish_by(a, h, k, 1.0 / a[0])
+}
+
+/// [`log_finish`] with its factor 1/a₀ given (see [`div_finish_by`]).
+#[inline(always)]
+pub fn log_finish_by(a: &Coefficients, h: f64, k: usize, inv_a0: f64) -> f64 {
+    (a[k] - h * RECIPROCALS[k]) * inv_a0
 }
 
 /// Coefficient k ≥ 1 of (sin a, cos a) from the [`weighted_history`] of a

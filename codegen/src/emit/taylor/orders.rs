@@ -134,13 +134,29 @@ fn linear(d: &Ctx, p: &Program, op: &Op, at: At) -> Option<TokenStream> {
     }
 }
 
+/// The name of op `index`'s factor known from order 0 on (see
+/// [`order_factor`]).
+pub(super) fn factor_name(index: usize) -> proc_macro2::Ident {
+    format_ident!("inv{index}")
+}
+
+/// Whether an op's finish multiplies by a factor that order 0 fixes (1/b₀
+/// of a quotient, 1/(2c₀) of a square root, 1/a₀ of a logarithm): the
+/// series works it out once, at order 0, into `inv{op}`, rather than
+/// dividing at every order (the same value, so the same bits).
+pub(super) fn order_factor(op: &Op) -> bool {
+    matches!(op, Op::Div { .. } | Op::Sqrt { .. } | Op::Log { .. })
+}
+
 /// Order 0: each function's value (the runtime's recurrences at order 0).
 fn order_zero(d: &Ctx, t: &Transform, range: Range<usize>, solve: Option<&Solve>) -> TokenStream {
     let tay = quote! { ::dalembert_runtime::taylor };
-    let stmts = t.ops[range].iter().map(|op| {
+    let first = range.start;
+    let stmts = t.ops[range].iter().enumerate().map(|(i, op)| {
         if let Some(l) = linear(d, &t.numbers, op, At::Zero) {
             return l;
         }
+        let inv = factor_name(first + i);
         match op {
             Op::Mul { dst, a, b } => {
                 let (dst, a, b) = (series(*dst), series(*a), series(*b));
@@ -153,11 +169,22 @@ fn order_zero(d: &Ctx, t: &Transform, range: Range<usize>, solve: Option<&Solve>
             Op::Recip { dst, a } => unary(quote! { #tay::recip }, *dst, *a, None),
             Op::Div { dst, a, b } => {
                 let (dst, a, b) = (series(*dst), series(*a), series(*b));
-                quote! { #dst[0] = #tay::div(&#dst, &#a, &#b, 0); }
+                quote! {
+                    #dst[0] = #tay::div(&#dst, &#a, &#b, 0);
+                    #inv = 1.0 / #b[0];
+                }
             }
-            Op::Sqrt { dst, a } => unary(quote! { #tay::sqrt }, *dst, *a, None),
+            Op::Sqrt { dst, a } => {
+                let value = unary(quote! { #tay::sqrt }, *dst, *a, None);
+                let dst = series(*dst);
+                quote! { #value #inv = 0.5 / #dst[0]; }
+            }
             Op::Exp { dst, a } => unary(quote! { #tay::exp }, *dst, *a, None),
-            Op::Log { dst, a } => unary(quote! { #tay::log }, *dst, *a, None),
+            Op::Log { dst, a } => {
+                let value = unary(quote! { #tay::log }, *dst, *a, None);
+                let a = series(*a);
+                quote! { #value #inv = 1.0 / #a[0]; }
+            }
             Op::Power { dst, a, alpha } => {
                 let alpha = Literal::f64_suffixed(*alpha);
                 unary(quote! { #tay::power }, *dst, *a, Some(quote! { #alpha, }))
@@ -252,6 +279,7 @@ fn order_k(d: &Ctx, t: &Transform, plan: &GroupPlan) -> (TokenStream, TokenStrea
                 return l;
             }
             let w = format_ident!("w{index}");
+            let inv = factor_name(index);
             match op {
                 Op::Mul { dst, a, b } => {
                     let (dst, a, b) = (series(*dst), series(*a), series(*b));
@@ -271,12 +299,12 @@ fn order_k(d: &Ctx, t: &Transform, plan: &GroupPlan) -> (TokenStream, TokenStrea
                 Op::Div { dst, a, b } => {
                     let (dst, a, b) = (series(*dst), series(*a), series(*b));
                     let h = history();
-                    quote! { #dst[k] = #tay::div_finish(&#dst, &#a, &#b, #h, k); }
+                    quote! { #dst[k] = #tay::div_finish_by(&#dst, &#a, &#b, #h, k, #inv); }
                 }
                 Op::Sqrt { dst, a } => {
                     let (dst, a) = (series(*dst), series(*a));
                     let h = history();
-                    quote! { #dst[k] = #tay::sqrt_finish(&#dst, &#a, #h, k); }
+                    quote! { #dst[k] = #tay::sqrt_finish_by(&#a, #h, k, #inv); }
                 }
                 Op::Power { dst, a, alpha } => {
                     let (dst, a) = (series(*dst), series(*a));
@@ -296,7 +324,7 @@ fn order_k(d: &Ctx, t: &Transform, plan: &GroupPlan) -> (TokenStream, TokenStrea
                     let (dst, a) = (series(*dst), series(*a));
                     let h = history();
                     quote! {
-                        #dst[k] = #tay::log_finish(&#a, #h, k);
+                        #dst[k] = #tay::log_finish_by(&#a, #h, k, #inv);
                         #w[k] = k as f64 * #dst[k];
                     }
                 }

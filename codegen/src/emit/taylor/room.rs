@@ -131,7 +131,17 @@ pub(super) fn prelude(d: &Ctx, t: &Transform, plan: &Plan) -> TokenStream {
         let len = Literal::usize_unsuffixed(n * (n + 1) / 2);
         quote! { let mut factor = [0.0f64; #len]; }
     });
-    quote! { #(#params)* #numbers #(#temps)* #arrays #lanes #factor }
+    // Each factor that order 0 fixes (`orders::order_factor`).
+    let inverses = t
+        .ops
+        .iter()
+        .enumerate()
+        .filter(|(_, op)| super::orders::order_factor(op))
+        .map(|(index, _)| {
+            let inv = super::orders::factor_name(index);
+            quote! { let mut #inv = 0.0f64; }
+        });
+    quote! { #(#params)* #numbers #(#temps)* #arrays #lanes #factor #(#inverses)* }
 }
 
 /// Whether an op's history is weighted by j (it keeps the series j·xⱼ of
