@@ -250,9 +250,11 @@ impl Plan {
     /// without its logarithms and exponential: for each j ∈ {p − 1, p},
     /// τ ≤ hⱼ is ‖xⱼ‖ (τ e^(0.7/(p−1)))ʲ ≤ max(1, ‖x₀‖) ε, and where the
     /// asymptotic bound applies also ‖xⱼ‖ (τ e^(0.7/(p−1)))ʲ e²ʲ ≤
-    /// max(1, ‖x₀‖). Where the power leaves the normal range of f64 the
-    /// length itself decides.
+    /// max(1, ‖x₀‖) (its factor is e⁻², the one finite value
+    /// `log_asymptotic` takes). Where the power leaves the normal range of
+    /// f64 the length itself decides.
     pub fn covers(&self, r: &Reach, tau: f64) -> bool {
+        debug_assert!(self.log_asymptotic == -2.0 || self.log_asymptotic == f64::INFINITY);
         if tau.is_nan() || tau > self.method.max_step {
             return false;
         }
