@@ -192,20 +192,15 @@ impl Plan {
 
     /// [`Taylor::step`].
     pub fn step<const N: usize>(&self, s: &Series<N>) -> f64 {
-        self.step_at(s, s.order)
-    }
-
-    /// The step the series `s` truncated at order p (2 ≤ p ≤ `s.order`)
-    /// would take: the coefficients up to p are the same whatever order the
-    /// series was computed to, so a longer series tells what a shorter one
-    /// would have done.
-    pub fn step_at<const N: usize>(&self, s: &Series<N>, p: usize) -> f64 {
-        self.length(&self.reach(s, p))
+        self.length(&self.reach(s, s.order))
     }
 
     /// What the step estimates read off the series `s` truncated at order
     /// p (2 ≤ p ≤ `s.order`): ‖x₀‖∞, ‖x_{p−1}‖∞ and ‖xₚ‖∞, in one pass; a
-    /// NaN is passed over (the state evaluated on the step catches it).
+    /// NaN is passed over (the state evaluated on the step catches it). The
+    /// coefficients up to p are the same whatever order the series was
+    /// computed to, so a longer series tells what a shorter one would have
+    /// done.
     pub fn reach<const N: usize>(&self, s: &Series<N>, p: usize) -> Reach {
         let mut norms = [0.0f64; 3];
         for i in 0..N {
