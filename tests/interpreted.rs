@@ -246,8 +246,8 @@ fn runs_agree<M: Surfaces<N> + FromParams, const N: usize>(d: &Derivation, setti
         agree(&format!("{module} v at t = {t}"), &a.state.v, &b.state.v);
         agree(
             &format!("{module} energy at t = {t}"),
-            &[a.energy],
-            &[b.energy],
+            &[a.energy(&c)],
+            &[b.energy(&i)],
         );
         agree(
             &format!("{module} T at t = {t}"),

@@ -11,6 +11,7 @@ use dalembert::runtime::simulate::{
     Integrator, Settings, SimError, Simulator, State, Stats, Taylor,
 };
 use dalembert::runtime::taylor::Series;
+use std::cell::Cell;
 
 #[path = "common/bounce.rs"]
 mod bounce;
@@ -207,7 +208,7 @@ fn pendulum_period_with_taylor() {
     let mut worst = 0.0f64;
     let stats = sim
         .run(period, |s| {
-            worst = worst.max((s.energy - e0).abs());
+            worst = worst.max((s.energy(&p) - e0).abs());
             true
         })
         .unwrap();
@@ -263,8 +264,9 @@ fn pendulum_hits_the_wall_where_dormand_prince_does() {
 }
 
 /// chain_4 seen through the traits' required methods, as a hand-written
-/// model would be, with the series its [`Offered`] says.
-struct Plain(Chain4, Offered);
+/// model would be, with the series its [`Offered`] says; it counts the
+/// evaluations of its energy (T and V).
+struct Plain(Chain4, Offered, Cell<u64>);
 
 /// What [`Plain`] offers Taylor's method.
 #[derive(Clone, Copy, PartialEq)]
@@ -273,6 +275,8 @@ enum Offered {
     Nothing,
     /// chain_4's series, with a NaN in one velocity's coefficient of order 7.
     Poisoned,
+    /// chain_4's series as they are.
+    Series,
 }
 
 type W4 = chain_4::Wall;
@@ -300,6 +304,7 @@ impl Model<4, 4> for Plain {
         self.0.mass_matrix(q)
     }
     fn kinetic_energy(&self, q: &[f64; 4], v: &[f64; 4]) -> f64 {
+        self.2.set(self.2.get() + 1);
         self.0.kinetic_energy(q, v)
     }
     fn constraints(&self, q: &[f64; 4]) -> dalembert::runtime::Rows<4> {
@@ -326,6 +331,7 @@ impl Walls<4, 4> for Plain {
 }
 impl Dynamics<4> for Plain {
     fn potential(&self, q: &[f64; 4]) -> f64 {
+        self.2.set(self.2.get() + 1);
         self.0.potential(q)
     }
     fn forcing(&self, q: &[f64; 4], v: &[f64; 4]) -> [f64; 4] {
@@ -345,7 +351,7 @@ impl Dynamics<4> for Plain {
             return false;
         }
         let done = self.0.taylor_series(s, scratch, order);
-        if order >= 7 {
+        if self.1 == Offered::Poisoned && order >= 7 {
             s.v[2][7] = f64::NAN;
         }
         done
@@ -383,7 +389,11 @@ fn models_without_series_refuse_taylor() {
     // The generated model itself has them and runs.
     assert!(Simulator::new(&chain, start, taylor()).is_ok());
     assert!(matches!(
-        Simulator::new(&Plain(chain, Offered::Nothing), start, taylor()),
+        Simulator::new(
+            &Plain(chain, Offered::Nothing, Cell::default()),
+            start,
+            taylor()
+        ),
         Err(SimError::NoSeries)
     ));
 }
@@ -394,7 +404,7 @@ fn models_without_series_refuse_taylor() {
 #[test]
 fn non_finite_series_stop_the_run() {
     let chain = Chain4::default();
-    let model = Plain(chain, Offered::Poisoned);
+    let model = Plain(chain, Offered::Poisoned, Cell::default());
     let mut sim = Simulator::new(&model, chain_4_start(&chain), taylor()).unwrap();
     let err = sim.run(10.0, |_| true).unwrap_err();
     assert!(
@@ -407,6 +417,35 @@ fn non_finite_series_stop_the_run() {
         ),
         "{err:?}"
     );
+}
+
+/// A step works out its energy only when asked: a run with either method
+/// evaluates T and V nowhere, and `Step::energy` is the model's energy at
+/// the step's end.
+#[test]
+fn steps_work_out_the_energy_only_when_asked() {
+    let chain = Chain4::default();
+    let model = Plain(chain, Offered::Series, Cell::default());
+    for settings in [taylor(), Settings::default()] {
+        let mut sim = Simulator::new(&model, chain_4_start(&chain), settings).unwrap();
+        let mut last = None;
+        let stats = sim
+            .run(2.0, |s| {
+                last = Some(*s);
+                true
+            })
+            .unwrap();
+        assert!(stats.steps > 10, "{stats:?}");
+        assert_eq!(
+            model.2.get(),
+            0,
+            "T or V evaluated in a run that never asked"
+        );
+        let s = last.unwrap();
+        assert_eq!(s.energy(&model), chain.energy(&s.state.q, &s.state.v));
+        assert_eq!(model.2.get(), 2, "one T and one V");
+        model.2.set(0);
+    }
 }
 
 /// The §3.1 ball rolling into the wall, in Euler angles and with a unit
@@ -434,8 +473,8 @@ fn rolling_ball_in_euler_angles_and_quaternions_with_taylor() {
         let (mut out, mut de, mut dh) = (Vec::new(), 0.0f64, 0.0f64);
         let stats = sim
             .run(f64::INFINITY, |s| {
-                de = de.max((s.energy - e0).abs() / e0);
-                dh = dh.max(s.residual.position);
+                de = de.max((s.energy(m) - e0).abs() / e0);
+                dh = dh.max(s.residual(m).position);
                 if let Some(c) = s.collision {
                     out.push((c.t, c.v_minus[0], c.v_plus[1]));
                 }
@@ -521,7 +560,7 @@ fn rolling_ball_in_euler_angles_at_the_models_order() {
         let (mut impacts, mut de) = (Vec::new(), 0.0f64);
         let stats = sim
             .run(f64::INFINITY, |s| {
-                de = de.max((s.energy - e0).abs() / e0);
+                de = de.max((s.energy(&ball) - e0).abs() / e0);
                 if let Some(c) = s.collision {
                     impacts.push(c.t);
                 }

@@ -466,19 +466,13 @@ fn integrate<M: Surfaces<N>, const N: usize>(
             })?;
         }
         let s = &step.state;
-        if !step.energy.is_finite() {
-            failure = Some(format!("the energy became {} at t = {}", step.energy, s.t));
+        let energy = step.energy(model);
+        if !energy.is_finite() {
+            failure = Some(format!("the energy became {energy} at t = {}", s.t));
         }
         let on_grid = s.t >= grid(k);
         if on_grid || step.collision.is_some() || failure.is_some() {
-            out.push(Row {
-                t: s.t,
-                q: s.q,
-                v: s.v,
-                energy: step.energy,
-                residual: [step.residual.velocity, step.residual.position],
-                event: None,
-            })?;
+            out.push(Row::of(model, s.t, s.q, s.v))?;
         }
         if failure.is_some() {
             break;

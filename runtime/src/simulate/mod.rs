@@ -232,7 +232,7 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
         }
     }
 
-    /// Energy and constraint residuals of the current state.
+    /// Constraint residuals of the current state.
     pub fn residual(&self) -> Residual {
         residual(self.model, &self.state.q, &self.state.v)
     }
@@ -347,8 +347,6 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
             t0,
             state: self.state,
             collision,
-            energy: self.model.energy(&self.state.q, &self.state.v),
-            residual: self.residual(),
         }
     }
 
