@@ -102,7 +102,7 @@ impl<W, const N: usize> Step<W, N> {
     /// Total energy T + V of `model` at the end of the step. Worked out
     /// when asked, not by the step: a step's own work is the motion, and a
     /// caller that does not read the energy does not pay for it (in
-    /// §3.2.1's bounces in Euler angles it would be about 4 % of a step).
+    /// §3.2.1's bounces in Euler angles it would be about 3 % of a step).
     pub fn energy<M: Dynamics<N>>(&self, model: &M) -> f64 {
         model.energy(&self.state.q, &self.state.v)
     }
