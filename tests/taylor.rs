@@ -2,9 +2,8 @@
 //! (checked in `tests/taylor_series.rs`): the paper's §3.2.1 run in two
 //! states of the ball, the Cartesian pendulum's elliptic period and its
 //! wall hits, the triple pendulum's tip on the floor, the rolling ball
-//! meeting the wall, the typed errors of a
-//! model without series and of a non-finite series, and a step's energy
-//! worked out only when asked.
+//! meeting the wall, the typed errors of a model without series and of a
+//! non-finite series, and a step's energy worked out only when asked.
 
 use dalembert::models::*;
 use dalembert::runtime::dynamics::DynamicsError;
