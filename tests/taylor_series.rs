@@ -234,6 +234,8 @@ fn against_differences<M: Surfaces<N> + Default, const N: usize>() {
     };
     let mut s = Series::at(&start.q, &start.v);
     if !m.taylor_series(&mut s, &mut Default::default(), 16) {
+        // No closed-form q̈ to differentiate either (see
+        // `series_exist_where_closed_forms_do`).
         return;
     }
     // A twentieth of Taylor's step at the start (infinite for a motion
