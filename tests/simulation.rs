@@ -11,10 +11,10 @@ use dalembert::models::{BallBounce, BallWallEuler, Chain3, MassesOnLine, Pendulu
 
 #[path = "common/bounce.rs"]
 mod bounce;
+mod common;
+use common::{dormand_prince, initial};
 use dalembert::runtime::prelude::*;
-use dalembert::runtime::simulate::{
-    DormandPrince, Integrator, Rk4, Settings, Simulator, State, admissible,
-};
+use dalembert::runtime::simulate::{Integrator, Rk4, Settings, Simulator, State, admissible};
 
 // ------------------------------------------------------------ helpers
 
@@ -42,27 +42,6 @@ fn pendulum_time(l: f64, g: f64, theta0: f64, theta: f64) -> f64 {
     let k = (theta0 / 2.0).sin();
     let phi = ((theta / 2.0).sin() / k).asin();
     (l / g).sqrt() * (elliptic_f(std::f64::consts::FRAC_PI_2, k) + elliptic_f(phi, k))
-}
-
-fn dormand_prince(rtol: f64) -> Settings {
-    Settings {
-        integrator: Integrator::DormandPrince(DormandPrince {
-            rtol,
-            atol: rtol * 1e-2,
-            max_step: f64::INFINITY,
-        }),
-        ..Settings::default()
-    }
-}
-
-/// The model file's initial state.
-fn initial<M: Dynamics<N> + Default, const N: usize>() -> State<N> {
-    let m = M::default();
-    State {
-        t: 0.0,
-        q: m.initial_coordinates(),
-        v: m.initial_velocities(),
-    }
 }
 
 /// The bob of `PendulumWall` at rest at angle θ₀ on the left.
@@ -228,7 +207,7 @@ fn nonholonomic_pendulum_is_periodic_over_ten_thousand_bounces() {
 #[test]
 fn parabolic_flights_end_on_the_floor_in_one_step() {
     let ball = BallBounce::default();
-    let start = initial::<BallBounce, 6>();
+    let start = initial(&BallBounce::default());
     let flight = 2.0 * 2.0 / ball.params().g;
     let mut sim = Simulator::new(&ball, start, Settings::default()).unwrap();
     let mut n = 0u64;
@@ -259,7 +238,7 @@ fn parabolic_flights_end_on_the_floor_in_one_step() {
 #[test]
 fn aimed_steps_find_the_collisions_fixed_steps_find() {
     let chain = Chain3::default();
-    let start = initial::<Chain3, 3>();
+    let start = initial(&Chain3::default());
     let collisions = |settings: Settings| {
         let mut sim = Simulator::new(&chain, start, settings).unwrap();
         let mut found = Vec::new();

@@ -9,13 +9,15 @@ use dalembert::models::*;
 use dalembert::runtime::dynamics::DynamicsError;
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
-    DormandPrince, Integrator, Settings, SimError, Simulator, State, Stats, Taylor,
+    Integrator, Settings, SimError, Simulator, State, Stats, Taylor,
 };
 use dalembert::runtime::taylor::Series;
 use std::cell::Cell;
 
 #[path = "common/bounce.rs"]
 mod bounce;
+mod common;
+use common::{dormand_prince, initial};
 
 fn taylor() -> Settings {
     Settings {
@@ -248,15 +250,7 @@ fn pendulum_hits_the_wall_where_dormand_prince_does() {
         .unwrap();
         t
     };
-    let dp = Settings {
-        integrator: Integrator::DormandPrince(dalembert::runtime::simulate::DormandPrince {
-            rtol: 1e-13,
-            atol: 1e-15,
-            max_step: f64::INFINITY,
-        }),
-        ..Settings::default()
-    };
-    let (a, b) = (times(taylor()), times(dp));
+    let (a, b) = (times(taylor()), times(dormand_prince(1e-13)));
     assert!(a.len() >= 5);
     assert_eq!(a.len(), b.len());
     for (x, y) in a.iter().zip(&b) {
@@ -373,20 +367,12 @@ impl Surfaces<4> for Plain {
     }
 }
 
-fn chain_4_start(chain: &Chain4) -> State<4> {
-    State {
-        t: 0.0,
-        q: chain.initial_coordinates(),
-        v: chain.initial_velocities(),
-    }
-}
-
 /// A model without series: Taylor's method is refused with a typed error,
 /// not run wrongly.
 #[test]
 fn models_without_series_refuse_taylor() {
     let chain = Chain4::default();
-    let start = chain_4_start(&chain);
+    let start = initial(&chain);
     // The generated model itself has them and runs.
     assert!(Simulator::new(&chain, start, taylor()).is_ok());
     assert!(matches!(
@@ -406,7 +392,7 @@ fn models_without_series_refuse_taylor() {
 fn non_finite_series_stop_the_run() {
     let chain = Chain4::default();
     let model = Plain(chain, Offered::Poisoned, Cell::default());
-    let mut sim = Simulator::new(&model, chain_4_start(&chain), taylor()).unwrap();
+    let mut sim = Simulator::new(&model, initial(&chain), taylor()).unwrap();
     let err = sim.run(10.0, |_| true).unwrap_err();
     assert!(
         matches!(
@@ -428,7 +414,7 @@ fn steps_work_out_the_energy_only_when_asked() {
     let chain = Chain4::default();
     let model = Plain(chain, Offered::Series, Cell::default());
     for settings in [taylor(), Settings::default()] {
-        let mut sim = Simulator::new(&model, chain_4_start(&chain), settings).unwrap();
+        let mut sim = Simulator::new(&model, initial(&chain), settings).unwrap();
         let mut last = None;
         let stats = sim
             .run(2.0, |s| {
@@ -457,11 +443,7 @@ fn steps_work_out_the_energy_only_when_asked() {
 #[test]
 fn triple_pendulum_tip_meets_the_floor_with_taylor() {
     let chain = Chain3::default();
-    let start = State {
-        t: 0.0,
-        q: chain.initial_coordinates(),
-        v: chain.initial_velocities(),
-    };
+    let start = initial(&chain);
     let e0 = chain.energy(&start.q, &start.v);
     let impacts = |settings: Settings| {
         let mut sim = Simulator::new(&chain, start, settings).unwrap();
@@ -475,14 +457,7 @@ fn triple_pendulum_tip_meets_the_floor_with_taylor() {
         (found, de)
     };
     let (taylor, de) = impacts(taylor());
-    let (reference, _) = impacts(Settings {
-        integrator: Integrator::DormandPrince(DormandPrince {
-            rtol: 1e-13,
-            atol: 1e-15,
-            ..DormandPrince::default()
-        }),
-        ..Settings::default()
-    });
+    let (reference, _) = impacts(dormand_prince(1e-13));
     eprintln!("{} impacts, energy {de:.1e}", taylor.len());
     // Seen (2026-12-04): 4 impacts; |Δt| ≤ 1.8e-14, |Δq| ≤ 8.7e-14,
     // |Δv⁺| ≤ 6.9e-13, the energy within 1.6e-14 relative.
@@ -522,11 +497,7 @@ fn rolling_ball_in_euler_angles_and_quaternions_with_taylor() {
     let alpha = p.a * p.m * p.r * p.r / (p.J + p.m * p.r * p.r);
     let first = (-0.5 + (0.25 + 2.0 * alpha * (1.5 - p.r)).sqrt()) / alpha;
     fn run<M: Surfaces<N> + Default, const N: usize>(m: &M) -> (Vec<(f64, f64, f64)>, f64, f64) {
-        let start = State {
-            t: 0.0,
-            q: m.initial_coordinates(),
-            v: m.initial_velocities(),
-        };
+        let start = initial(m);
         let e0 = m.energy(&start.q, &start.v);
         let mut sim = Simulator::new(m, start, taylor()).unwrap();
         let (mut out, mut de, mut dh) = (Vec::new(), 0.0f64, 0.0f64);
@@ -604,11 +575,7 @@ fn rolling_ball_in_euler_angles_and_quaternions_with_taylor() {
 fn rolling_ball_in_euler_angles_at_the_models_order() {
     use dalembert::runtime::simulate::DormandPrince;
     let ball = BallWallEuler::default();
-    let start = State {
-        t: 0.0,
-        q: ball.initial_coordinates(),
-        v: ball.initial_velocities(),
-    };
+    let start = initial(&ball);
     let e0 = ball.energy(&start.q, &start.v);
     let run = |integrator| {
         let settings = Settings {

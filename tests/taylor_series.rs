@@ -11,11 +11,11 @@
 use dalembert::for_each_model;
 use dalembert::models::*;
 use dalembert::runtime::prelude::*;
-use dalembert::runtime::simulate::{DormandPrince, Integrator, Settings, Simulator, State, Taylor};
+use dalembert::runtime::simulate::{Simulator, Taylor};
 use dalembert::runtime::taylor::{CAPACITY, MAX_ORDER, Series, eval};
 
 mod common;
-use common::{for_random_cases, onto_kernel};
+use common::{dormand_prince, for_random_cases, initial, onto_kernel};
 
 /// Binomial coefficient C(n, k) as f64.
 fn binomial(n: usize, k: usize) -> f64 {
@@ -227,11 +227,7 @@ fn pendulum_series_is_the_angles() {
 /// the run's error weighs on them as 1/h, 1/h² and 1/h³.
 fn against_differences<M: Surfaces<N> + Default, const N: usize>() {
     let m = M::default();
-    let start = State {
-        t: 0.0,
-        q: m.initial_coordinates(),
-        v: m.initial_velocities(),
-    };
+    let start = initial(&m);
     let mut s = Series::at(&start.q, &start.v);
     if !m.taylor_series(&mut s, &mut Default::default(), 16) {
         // No closed-form q̈ to differentiate either (see
@@ -241,15 +237,7 @@ fn against_differences<M: Surfaces<N> + Default, const N: usize>() {
     // A twentieth of Taylor's step at the start (infinite for a motion
     // whose series ends, so at most 10 ms).
     let h = (0.05 * Taylor::default().step(&s)).min(1e-2);
-    let settings = Settings {
-        integrator: Integrator::DormandPrince(DormandPrince {
-            rtol: 1e-13,
-            atol: 1e-15,
-            ..DormandPrince::default()
-        }),
-        ..Settings::default()
-    };
-    let mut sim = Simulator::new(&m, start, settings).unwrap();
+    let mut sim = Simulator::new(&m, start, dormand_prince(1e-13)).unwrap();
     let mut states = vec![start];
     for j in 1..=4 {
         let stats = sim.run(j as f64 * h, |s| s.collision.is_none()).unwrap();

@@ -2,7 +2,8 @@
 
 #![allow(dead_code)] // each test binary uses some of these
 
-use dalembert::runtime::{FromParams, Model, Rows};
+use dalembert::runtime::simulate::{DormandPrince, Integrator, Settings, State};
+use dalembert::runtime::{Dynamics, FromParams, Model, Rows};
 use nalgebra::DMatrix;
 use proptest::test_runner::{Config, TestCaseError, TestRunner};
 
@@ -81,4 +82,25 @@ pub fn toml_files(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
         .collect();
     files.sort();
     files
+}
+
+/// The model file's initial state of `m`, at t = 0.
+pub fn initial<M: Dynamics<N>, const N: usize>(m: &M) -> State<N> {
+    State {
+        t: 0.0,
+        q: m.initial_coordinates(),
+        v: m.initial_velocities(),
+    }
+}
+
+/// Dormand–Prince at `rtol`, with atol a hundredth of it.
+pub fn dormand_prince(rtol: f64) -> Settings {
+    Settings {
+        integrator: Integrator::DormandPrince(DormandPrince {
+            rtol,
+            atol: rtol * 1e-2,
+            max_step: f64::INFINITY,
+        }),
+        ..Settings::default()
+    }
 }
