@@ -1,12 +1,69 @@
 //! Events on a step: where the motion is predicted to meet a wall (so that
 //! adaptive steps end there), and where a step actually crosses one,
-//! located on the dense output.
+//! located by evaluating each wall's f itself along the step's motion (a
+//! Runge–Kutta step's dense output, or the polynomial of a step of
+//! Taylor's method whose walls' series disagree with f at its end).
 
 use super::integrator::{Method, RungeKutta, Trial};
 use super::phase::Phase;
 use super::thresholds::{ROOT_ITERATIONS, SHORTEST_AIM_ULPS};
 use super::{SimError, Simulator};
+use crate::taylor::Series;
 use crate::{Surfaces, libm, linalg};
+
+/// The motion over one step, at θ ∈ [0, 1] of it.
+pub(super) trait Path<const N: usize> {
+    /// (q, q̇) at θ.
+    fn state(&self, theta: f64) -> Phase<N>;
+
+    /// q at θ (a wall's f needs no more).
+    fn position(&self, theta: f64) -> [f64; N] {
+        self.state(theta).q
+    }
+}
+
+/// A Runge–Kutta step of length `h` from `y0`: its ends, and its dense
+/// output between them.
+pub(super) struct RkStep<'a, const N: usize> {
+    pub y0: &'a Phase<N>,
+    pub trial: &'a Trial<N>,
+    pub h: f64,
+}
+
+impl<const N: usize> Path<N> for RkStep<'_, N> {
+    fn state(&self, theta: f64) -> Phase<N> {
+        if theta == 0.0 {
+            *self.y0
+        } else if theta == 1.0 {
+            self.trial.y1
+        } else {
+            self.trial.dense.at(theta, self.h)
+        }
+    }
+
+    fn position(&self, theta: f64) -> [f64; N] {
+        if theta == 0.0 {
+            self.y0.q
+        } else if theta == 1.0 {
+            self.trial.y1.q
+        } else {
+            self.trial.dense.position(theta, self.h)
+        }
+    }
+}
+
+/// A step of Taylor's method of length `tau` along `series`.
+pub(super) struct SeriesStep<'a, const N: usize> {
+    pub series: &'a Series<N>,
+    pub tau: f64,
+}
+
+impl<const N: usize> Path<N> for SeriesStep<'_, N> {
+    fn state(&self, theta: f64) -> Phase<N> {
+        let (q, v) = self.series.state(theta * self.tau);
+        Phase { q, v }
+    }
+}
 
 /// A collision predicted from f's second-order Taylor polynomial.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -22,8 +79,9 @@ pub(super) struct Aim {
 pub(super) struct Crossing {
     /// Index into the model's `walls()`.
     pub wall: usize,
-    /// When, on the dense output.
+    /// When, and where on the step (θ ∈ [0, 1]).
     pub t: f64,
+    pub theta: f64,
 }
 
 impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
@@ -59,24 +117,25 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         best
     }
 
-    /// The first wall crossed on the step (index into the model's `walls()`, time on
-    /// the dense output), if any.
+    /// The first wall crossed on the step of length `h` from t0 whose motion
+    /// is `path` (index into the model's `walls()`, time on the path), if
+    /// any.
     pub(super) fn first_crossing(
-        &mut self,
-        y0: &Phase<N>,
-        trial: &Trial<N>,
+        &self,
+        path: &impl Path<N>,
         t0: f64,
         h: f64,
     ) -> Result<Option<Crossing>, SimError<M::Wall>> {
         let mut best: Option<Crossing> = None;
         let mut second: Option<Crossing> = None;
         for k in 0..self.model.walls().len() {
-            let Some(theta) = self.wall_crossing(k, y0, trial, t0, h)? else {
+            let Some(theta) = self.wall_crossing(k, path, t0, h)? else {
                 continue;
             };
             let now = Crossing {
                 wall: k,
                 t: t0 + theta * h,
+                theta,
             };
             match best {
                 Some(b) if b.t <= now.t => {
@@ -104,7 +163,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
 
     /// Where on the step (θ ∈ [0, 1]) wall `k` is first met, if it is.
     ///
-    /// f and its rate df·q̇ are sampled on the dense output. Met means f
+    /// f and its rate df·q̇ are sampled along the path. Met means f
     /// goes from > 0 to ≤ 0 between samples; a dip below zero between two
     /// positive samples is caught by the rate changing sign (its bottom is
     /// located first). A wall just collided with starts at f ≈ 0 moving
@@ -113,17 +172,14 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     fn wall_crossing(
         &self,
         k: usize,
-        y0: &Phase<N>,
-        trial: &Trial<N>,
+        path: &impl Path<N>,
         t0: f64,
         h: f64,
     ) -> Result<Option<f64>, SimError<M::Wall>> {
         let on = OnStep {
             model: self.model,
             wall: self.model.walls()[k],
-            y0,
-            trial,
-            h,
+            path,
         };
         let (f, rate) = (|theta| on.f(theta), |theta| on.rate(theta));
         let n = self.settings.samples + 1;
@@ -171,14 +227,11 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     }
 }
 
-/// One wall seen along one step: f and its rate at any θ ∈ [0, 1], from the
-/// step's ends or its dense output.
-struct OnStep<'a, M: Surfaces<N>, const N: usize> {
+/// One wall seen along one step: f and its rate at any θ ∈ [0, 1].
+struct OnStep<'a, M: Surfaces<N>, P, const N: usize> {
     model: &'a M,
     wall: M::Wall,
-    y0: &'a Phase<N>,
-    trial: &'a Trial<N>,
-    h: f64,
+    path: &'a P,
 }
 
 /// f and its rate at one θ of a step.
@@ -189,37 +242,20 @@ struct Sample {
     rate: f64,
 }
 
-impl<M: Surfaces<N>, const N: usize> OnStep<'_, M, N> {
-    fn state(&self, theta: f64) -> Phase<N> {
-        if theta == 0.0 {
-            *self.y0
-        } else if theta == 1.0 {
-            self.trial.y1
-        } else {
-            self.trial.dense.at(theta, self.h)
-        }
-    }
-
-    /// f alone (its coordinates are half the dense output's work).
+impl<M: Surfaces<N>, P: Path<N>, const N: usize> OnStep<'_, M, P, N> {
+    /// f alone.
     fn f(&self, theta: f64) -> f64 {
-        let q = if theta == 0.0 {
-            self.y0.q
-        } else if theta == 1.0 {
-            self.trial.y1.q
-        } else {
-            self.trial.dense.position(theta, self.h)
-        };
-        self.model.surface(self.wall, &q)
+        self.model.surface(self.wall, &self.path.position(theta))
     }
 
     fn rate(&self, theta: f64) -> f64 {
-        let y = self.state(theta);
+        let y = self.path.state(theta);
         self.model.normal_velocity(self.wall, &y.q, &y.v)
     }
 
-    /// f and its rate from one dense-output evaluation.
+    /// f and its rate from one state on the path.
     fn sample(&self, theta: f64) -> Sample {
-        let y = self.state(theta);
+        let y = self.path.state(theta);
         Sample {
             theta,
             f: self.model.surface(self.wall, &y.q),

@@ -28,7 +28,14 @@
 //! tolerance asks for (Jorba & Zou); each wall's f along the step is a
 //! polynomial too ([`Surfaces::surface_series`]), and its first descending
 //! root on the step is found on that polynomial to rounding, so a collision
-//! needs no further steps. Time is summed in compensated arithmetic.
+//! needs no further steps. A wall's series bounds the step as the motion's
+//! does (a wall through a square root or a quotient may converge on a far
+//! shorter interval than the motion), and at the end of every step each
+//! wall's f is evaluated itself: a step that would end beyond a wall, or at
+//! a collision off it, is searched again by f along the step's polynomial,
+//! as a Runge–Kutta step is on its dense output
+//! ([`Stats::direct_crossings`]). So no method reports a state beyond a
+//! wall. Time is summed in compensated arithmetic.
 //!
 //! Nothing is silently wrong: two walls met within a fraction
 //! [`Settings::simultaneous`] of a step of each other, a contact whose normal velocity
@@ -69,6 +76,7 @@ use crate::Surfaces;
 use crate::dynamics::{accelerations, qdd};
 use crate::taylor::Series;
 use dense_output::LastStep;
+use events::RkStep;
 use integrator::{Engine, Method, RungeKutta};
 use phase::{Phase, norm};
 use thresholds::{ADMISSIBLE, MAX_WALLS, ON_WALL, TAYLOR_REACH};
@@ -271,7 +279,12 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
             f: Some(trial.f1),
             t_hi,
         };
-        let found = match self.first_crossing(&y0, &trial, t0, h)? {
+        let path = RkStep {
+            y0: &y0,
+            trial: &trial,
+            h,
+        };
+        let found = match self.first_crossing(&path, t0, h)? {
             // Met at the very end of the step: polish from there.
             Some(c) if t1 - c.t <= reach => Some(at_end(c.wall, t1)),
             Some(c) => {

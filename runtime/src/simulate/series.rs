@@ -6,13 +6,17 @@
 //! the step's polynomial there, so a collision costs no further steps.
 
 use super::dense_output::LastStep;
+use super::events::SeriesStep;
 use super::integrator::{Plan, Reach};
 use super::phase::Phase;
-use super::thresholds::{SERIES_ROOT_ITERATIONS, SERIES_SAMPLES, step_too_small};
+use super::thresholds::{
+    POLISH_STEPS, SERIES_CHECK, SERIES_ROOT_ITERATIONS, SERIES_SAMPLES, TAYLOR_REACH,
+    step_too_small,
+};
 use super::{SimError, Simulator, State, Step};
-use crate::Surfaces;
 use crate::dynamics::DynamicsError;
 use crate::taylor::{CAPACITY, Coefficients, Series, degree, eval, eval_with_derivative};
+use crate::{Surfaces, libm};
 
 /// Whether `m` has the series Taylor's method needs (of the motion and of
 /// every wall's f), tried from the state at order 0 of `s` in the
@@ -73,15 +77,18 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             }
         }
         let mut limit = self.series(method, method.order, left)?;
+        let found = self.first_collision(&mut limit)?;
         let h = limit.length(t0)?;
         // The Runge–Kutta steps' rule (a fixed order far below the
         // tolerance's steps by about ε/‖q̇‖ at order 2).
         if step_too_small(h, t0) && h < left {
             return Err(SimError::StepTooSmall { t: t0, step: h });
         }
-        let found = self.first_collision(&mut limit)?;
         if tried {
-            let reach = found.map_or(h, |(_, tau)| tau);
+            // (From the motion's series alone: where a wall's series
+            // bounds the step, a lower order may fall short of it and cost
+            // a trial at the next landing.)
+            let reach = found.map_or(h, |f| f.tau);
             self.low_order = (self.low_order + 1..method.order)
                 .find(|&p| method.covers(&method.reach(&self.series, p), reach))
                 .unwrap_or(method.order);
@@ -125,73 +132,191 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     }
 
     /// The first collision on the step `limit` allows along
-    /// `self.series`: the wall's index and τ; grazing and simultaneous
-    /// contacts as errors.
-    fn first_collision(
-        &mut self,
-        limit: &mut Limit,
-    ) -> Result<Option<(usize, f64)>, SimError<M::Wall>> {
+    /// `self.series`; grazing and simultaneous contacts as errors. Each
+    /// wall's series also bounds the step (its roots are searched only
+    /// where it converges: [`Plan::tighten`]), so a wall met beyond where a
+    /// later wall's series converges is not on the step.
+    fn first_collision(&mut self, limit: &mut Limit) -> Result<Option<Found>, SimError<M::Wall>> {
         let (t0, m, s) = (self.state.t, self.model, &self.series);
         let scratch = &mut self.scratch;
-        let mut best: Option<(usize, f64)> = None;
-        let mut second: Option<f64> = None;
+        // The earliest and the next event: (wall, τ, what, the step's
+        // bounds then): what is Ok(f's scale) for a collision, Err(normal
+        // velocity) for a departure that turns back first.
+        let mut best: Option<(usize, f64, Result<f64, f64>, Reach)> = None;
+        let mut second: Option<(usize, f64, Reach)> = None;
         let mut f = [0.0; CAPACITY];
         for (k, &wall) in m.walls().iter().enumerate() {
             m.surface_series(wall, s, scratch, &mut f);
+            limit.tighten(&f);
             let departing = self.departing & (1 << k) != 0;
-            let tau = match limit.first_root(&f, s.order, departing, t0)? {
-                Ok(Some(tau)) => tau,
+            let (tau, what) = match limit.first_root(&f, s.order, departing, t0)? {
+                Ok(Some(tau)) => (tau, Ok(libm::fabs(f[0]).max(1.0))),
                 Ok(None) => continue,
-                Err(top) => {
-                    return Err(SimError::Grazing {
-                        wall,
-                        t: t0 + top,
-                        normal_velocity: eval_with_derivative(&f, s.order, top).1,
-                    });
-                }
+                Err(top) => (top, Err(eval_with_derivative(&f, s.order, top).1)),
             };
+            let reach = limit.reach;
             match best {
-                Some((_, b)) if b <= tau => second = Some(second.map_or(tau, |x| x.min(tau))),
+                Some((_, b, _, _)) if b <= tau => {
+                    if second.is_none_or(|(_, x, _)| tau < x) {
+                        second = Some((k, tau, reach));
+                    }
+                }
                 _ => {
-                    second = best.map(|(_, b)| b);
-                    best = Some((k, tau));
+                    second = best.map(|(j, b, _, r)| (j, b, r));
+                    best = Some((k, tau, what, reach));
                 }
             }
         }
-        if let (Some((k, a)), Some(b)) = (best, second)
+        // An event found before a later wall's series shortened the step
+        // may lie beyond it, and is then not on the step (the second comes
+        // no earlier than the first).
+        let on_step = |tau: f64, then: Reach| then == limit.reach || limit.covers(tau);
+        let Some((k, a, what, _)) = best.filter(|&(_, tau, _, r)| on_step(tau, r)) else {
+            return Ok(None);
+        };
+        let scale = match what {
+            Ok(scale) => scale,
+            Err(normal_velocity) => {
+                return Err(SimError::Grazing {
+                    wall: m.walls()[k],
+                    t: t0 + a,
+                    normal_velocity,
+                });
+            }
+        };
+        if let Some((j, b, _)) = second.filter(|&(_, tau, r)| on_step(tau, r))
             && b - a <= self.settings.simultaneity_window(t0 + a, limit.length(t0)?)
         {
-            let mut other = m.walls()[k];
-            for (j, &w) in m.walls().iter().enumerate() {
-                if j == k {
-                    continue;
-                }
-                m.surface_series(w, s, scratch, &mut f);
-                let departing = self.departing & (1 << j) != 0;
-                if limit.first_root(&f, s.order, departing, t0)? == Ok(Some(b)) {
-                    other = w;
-                    break;
-                }
-            }
             return Err(SimError::Simultaneous {
                 first: m.walls()[k],
-                second: other,
+                second: m.walls()[j],
                 t: t0 + a,
             });
         }
-        Ok(best)
+        Ok(Some(Found {
+            wall: k,
+            tau: a,
+            scale,
+        }))
+    }
+
+    /// Whether every wall, its f evaluated directly at the state (q, v)
+    /// where the step along the series ends, agrees with what was found on
+    /// the walls' series: on the wall `found` met (|f| within
+    /// [`SERIES_CHECK`] times the tolerance, at least the unit roundoff, of
+    /// max(1, |f₀|)), and not beyond any other (f > 0, or leaving a wall
+    /// just collided with). A series that converges on the step always
+    /// agrees; one that was trusted beyond where it describes f would
+    /// otherwise let the state through a wall. `Some(f)` where they agree,
+    /// with the f of the wall met (0 where none was).
+    fn agrees(
+        &self,
+        found: Option<Found>,
+        q: &[f64; N],
+        v: &[f64; N],
+        tolerance: f64,
+    ) -> Option<f64> {
+        let m = self.model;
+        let mut met = 0.0;
+        for (j, &wall) in m.walls().iter().enumerate() {
+            let f = m.surface(wall, q);
+            let fine = match found {
+                Some(c) if c.wall == j => {
+                    met = f;
+                    libm::fabs(f) <= SERIES_CHECK * tolerance.max(f64::EPSILON) * c.scale
+                }
+                _ => {
+                    f > 0.0
+                        || (self.departing & (1 << j) != 0 && m.normal_velocity(wall, q, v) > 0.0)
+                }
+            };
+            if !fine {
+                return None;
+            }
+        }
+        Some(met)
+    }
+
+    /// The collision with wall `k` found at τ on the step's polynomial
+    /// (where the state is `y` and the wall's f is `f`), moved onto the wall
+    /// as f itself has it: Newton's method on f along the polynomial, as a
+    /// Runge–Kutta step's collision is polished. f's series and f agree to
+    /// the tolerance, so the instant moves by about that over the normal
+    /// velocity; a correction is kept only while it brings f closer to 0
+    /// and stays within [`TAYLOR_REACH`] of τ.
+    fn onto_wall(
+        &self,
+        k: usize,
+        mut tau: f64,
+        mut y: ([f64; N], [f64; N]),
+        mut f: f64,
+    ) -> (f64, ([f64; N], [f64; N])) {
+        let (m, wall) = (self.model, self.model.walls()[k]);
+        let reach = TAYLOR_REACH * tau;
+        let start = tau;
+        for _ in 0..POLISH_STEPS {
+            let nv = m.normal_velocity(wall, &y.0, &y.1);
+            if f == 0.0 || !(nv < 0.0) {
+                break;
+            }
+            let next = tau - f / nv;
+            if !(next > 0.0 && libm::fabs(next - start) <= reach) || next == tau {
+                break;
+            }
+            let candidate = self.series.state(next);
+            let f_next = m.surface(wall, &candidate.0);
+            if !(libm::fabs(f_next) < libm::fabs(f)) {
+                break;
+            }
+            (tau, y, f) = (next, candidate, f_next);
+        }
+        (tau, y)
     }
 
     /// The step along `self.series`: to the collision `found`, else as
     /// far as `limit` allows (to `t_end` if that reaches it).
+    ///
+    /// The walls are checked where the step ends ([`Simulator::agrees`]);
+    /// where one disagrees, the step's first crossing is searched as a
+    /// Runge–Kutta step's is, by f itself along the step's polynomial
+    /// over the whole step
+    /// ([`Stats::direct_crossings`](super::Stats::direct_crossings)).
     fn take(
         &mut self,
         limit: &mut Limit,
         t_end: f64,
-        found: Option<(usize, f64)>,
+        mut found: Option<Found>,
     ) -> Result<Step<M::Wall, N>, SimError<M::Wall>> {
         let t0 = self.state.t;
         let left = limit.left;
+        let mut end = match found {
+            Some(c) => c.tau,
+            None => limit.length(t0)?,
+        };
+        let mut y = finite(self.series.state(end), t0)?;
+        let agreed = self.agrees(found, &y.0, &y.1, limit.plan.method.tolerance);
+        if let (Some(c), Some(f)) = (found, agreed) {
+            (end, y) = self.onto_wall(c.wall, c.tau, y, f);
+            found = Some(Found { tau: end, ..c });
+        }
+        if agreed.is_none() {
+            // The whole step is searched (a collision found on a series
+            // that f contradicts says nothing of where the wall is).
+            self.stats.direct_crossings += 1;
+            let h = limit.length(t0)?;
+            let path = SeriesStep {
+                series: &self.series,
+                tau: h,
+            };
+            found = self.first_crossing(&path, t0, h)?.map(|c| Found {
+                wall: c.wall,
+                tau: c.theta * h,
+                scale: 1.0,
+            });
+            end = found.map_or(h, |c| c.tau);
+            y = finite(self.series.state(end), t0)?;
+        }
+        let (q, v) = y;
         self.stats.steps += 1;
         let t0_low = self.t_low;
         let last = |stop| LastStep {
@@ -201,8 +326,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             interpolant: None,
         };
         match found {
-            Some((k, tau)) => {
-                let (q, v) = finite(self.series.state(tau), t0)?;
+            Some(Found { wall: k, tau, .. }) => {
                 let tc = self.time_after(tau);
                 let settings = self.settings;
                 let window = || settings.simultaneity_window(tc.0, limit.length_or_nan());
@@ -212,8 +336,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
                 Ok(self.report(t0, Some(collision)))
             }
             None => {
-                let h = limit.length(t0)?;
-                let (q, v) = finite(self.series.state(h), t0)?;
+                let h = end;
                 let (t1, low) = if h >= left {
                     (t_end, 0.0)
                 } else {
@@ -244,6 +367,15 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         let sum = hi + low;
         (sum, low - (sum - hi))
     }
+}
+
+/// A collision found on a step of Taylor's method: the wall's index, τ
+/// from the step's start, and the scale of its f there, max(1, |f₀|).
+#[derive(Clone, Copy, Debug)]
+struct Found {
+    wall: usize,
+    tau: f64,
+    scale: f64,
 }
 
 /// How far a step on a series may go: within the tolerance (the
@@ -280,6 +412,16 @@ impl Limit<'_> {
         *self
             .length
             .get_or_insert_with(|| plan.length(reach).min(left))
+    }
+
+    /// Bounds the step by one more series along it, a wall's f
+    /// ([`Plan::tighten`]).
+    fn tighten(&mut self, f: &Coefficients) {
+        let before = self.reach;
+        self.plan.tighten(&mut self.reach, f);
+        if self.reach != before {
+            self.length = None;
+        }
     }
 
     /// Whether τ is within the step.

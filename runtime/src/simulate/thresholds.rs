@@ -70,5 +70,11 @@ pub const SIMULTANEOUS_ULPS: f64 = 4.0;
 /// root is found by Newton's method on that polynomial.
 pub const SERIES_SAMPLES: usize = 16;
 
+/// A collision found on a wall's series is taken where f, evaluated
+/// directly at it, is within this many times Taylor's tolerance (at least
+/// the unit roundoff) of max(1, |f₀|); else the step's crossing is searched
+/// by f itself along the step.
+pub const SERIES_CHECK: f64 = 1e3;
+
 /// Newton (or bisection) steps at most on the step's polynomial.
 pub const SERIES_ROOT_ITERATIONS: usize = 100;

@@ -136,6 +136,12 @@ pub struct Stats {
     /// series once, and each convolution sums more products the higher the
     /// order.
     pub series_orders: u64,
+    /// Steps of Taylor's method at whose end a wall's f, evaluated
+    /// directly, disagreed with the wall's series (beyond the wall, or off
+    /// it at the collision found on the series), so that the step's first
+    /// crossing was searched by f itself along the step. Zero where every
+    /// wall's series describes f on the steps, as it should.
+    pub direct_crossings: u64,
 }
 
 /// Why the simulation stopped.
@@ -219,6 +225,42 @@ pub enum SimError<W> {
         /// How many it has.
         walls: usize,
     },
+}
+
+impl<W> SimError<W> {
+    /// The same error with each wall replaced by `f(wall)`: for a message
+    /// that names the walls as the model file does,
+    /// `e.map_wall(|w| model.wall_name(w))`.
+    pub fn map_wall<V>(self, mut f: impl FnMut(W) -> V) -> SimError<V> {
+        match self {
+            SimError::Dynamics { t, error } => SimError::Dynamics { t, error },
+            SimError::Inadmissible { residual } => SimError::Inadmissible { residual },
+            SimError::StartsBeyondWall { wall, surface } => SimError::StartsBeyondWall {
+                wall: f(wall),
+                surface,
+            },
+            SimError::Simultaneous { first, second, t } => SimError::Simultaneous {
+                first: f(first),
+                second: f(second),
+                t,
+            },
+            SimError::Grazing {
+                wall,
+                t,
+                normal_velocity,
+            } => SimError::Grazing {
+                wall: f(wall),
+                t,
+                normal_velocity,
+            },
+            SimError::SingularWall { wall, t } => SimError::SingularWall { wall: f(wall), t },
+            SimError::Projection { t, error } => SimError::Projection { t, error },
+            SimError::StepTooSmall { t, step } => SimError::StepTooSmall { t, step },
+            SimError::BadSettings => SimError::BadSettings,
+            SimError::NoSeries => SimError::NoSeries,
+            SimError::TooManyWalls { walls } => SimError::TooManyWalls { walls },
+        }
+    }
 }
 
 impl<W: core::fmt::Debug> core::fmt::Display for SimError<W> {

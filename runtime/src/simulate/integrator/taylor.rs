@@ -7,7 +7,7 @@
 
 use crate::libm;
 use crate::simulate::thresholds::SERIES_SAMPLES;
-use crate::taylor::{CAPACITY, MAX_ORDER, Series, SeriesWork};
+use crate::taylor::{CAPACITY, Coefficients, MAX_ORDER, Series, SeriesWork};
 
 /// A step's work besides the series of the motion and of the walls, the
 /// state on the step and the root search's samples, in multiply-adds, for
@@ -216,6 +216,25 @@ impl Plan {
             p,
             scale: norms[0].max(1.0),
             last: [norms[1], norms[2]],
+        }
+    }
+
+    /// What the step estimates read off one more series along the step, a
+    /// wall's f of order p (2 ≤ p ≤ its order), in the terms of `r`: a
+    /// root of f is searched only where f's own series converges, so its
+    /// last two terms bound the step as the motion's do, with f's own scale
+    /// max(1, |f₀|). `r` then covers an instant only where both did; NaN
+    /// is passed over as in [`Plan::reach`].
+    pub fn tighten(&self, r: &mut Reach, f: &Coefficients) {
+        debug_assert!(r.p >= 2 && r.p < CAPACITY);
+        let p = r.p;
+        // ‖fⱼ‖τʲ ≤ ε max(1, |f₀|) is ‖fⱼ‖ (scale / max(1, |f₀|)) τʲ ≤ ε scale.
+        let ratio = r.scale / libm::fabs(f[0]).max(1.0);
+        for (m, j) in r.last.iter_mut().zip([p - 1, p]) {
+            let x = libm::fabs(f[j]) * ratio;
+            if x > *m {
+                *m = x;
+            }
         }
     }
 
@@ -497,6 +516,59 @@ mod tests {
         line.q[0][1] = 1.0;
         line.order = 20;
         assert_eq!(t.step(&line), f64::INFINITY);
+    }
+
+    /// A wall's series bounds the step as the motion's does: tightened by
+    /// it, the step is the shorter of the motion's and the one f's series
+    /// alone would allow in its own scale, max(1, |f₀|), and `covers`
+    /// agrees; a wall whose series ends below order p − 1 (a flight's f of
+    /// degree 2) changes nothing.
+    #[test]
+    fn wall_series_bound_the_step() {
+        for plan in [
+            Plan::new(Taylor::default()),
+            Plan::new(Taylor {
+                fixed_order: Some(25),
+                ..Taylor::default()
+            }),
+        ] {
+            let p = plan.order;
+            // The motion x(t) = 1/(1 − t): radius of convergence 1.
+            let mut s = Series::<1>::at(&[1.0], &[1.0]);
+            s.order = p;
+            s.q[0] = [1.0; CAPACITY];
+            s.v[0] = core::array::from_fn(|k| (k + 1) as f64);
+            let motion = plan.reach(&s, p);
+            for (f0, radius) in [(3.0, 0.1), (0.25, 0.1), (1e3, 10.0), (-2.0, 0.01)] {
+                // f = f₀/(1 − t/radius): fₖ = f₀ radius⁻ᵏ.
+                let f: Coefficients = core::array::from_fn(|k| f0 * libm::pow(radius, -(k as f64)));
+                let mut tightened = motion;
+                plan.tighten(&mut tightened, &f);
+                let mut alone = Series::<1>::at(&[f0], &[0.0]);
+                alone.order = p;
+                alone.q[0] = f;
+                alone.v[0] = [0.0; CAPACITY];
+                let wall = plan.reach(&alone, p);
+                let (h, hm, hw) = (
+                    plan.length(&tightened),
+                    plan.length(&motion),
+                    plan.length(&wall),
+                );
+                assert!(
+                    (h - hm.min(hw)).abs() <= 1e-14 * h,
+                    "{f0} {radius}: {h} {hm} {hw}"
+                );
+                assert_eq!(radius < 1.0, hw < hm, "{f0} {radius}: {hm} {hw}");
+                for x in [0.5, 0.999, 1.001, 2.0] {
+                    assert_eq!(plan.covers(&tightened, x * h), x < 1.0, "{f0} {radius} {x}");
+                }
+            }
+            let mut flight = [0.0; CAPACITY];
+            flight[..3].copy_from_slice(&[0.5, -1.0, 3.0]);
+            let mut r = motion;
+            plan.tighten(&mut r, &flight);
+            assert_eq!(r, motion);
+        }
     }
 
     /// Whether an instant is within the step, decided by powers, agrees

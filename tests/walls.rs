@@ -1,0 +1,493 @@
+//! Walls that are not polynomials in the coordinates (`tests/walls/`: the
+//! unit disk's edge through a square root, a quotient, a logarithm, a sine
+//! and a tangent, an oval through an exponential; a Chaplygin sleigh in a
+//! round rink; a pendulum against a round peg), with and without gravity:
+//! every integrator meets them at the instants Dormand–Prince finds at rtol
+//! 1e-13 (the tangent, whose f is positive again beyond a pole outside the
+//! wall, Taylor's method only), and no state the simulator reports is ever
+//! beyond a wall.
+//!
+//! A wall's f along a step of Taylor's method is a series too, and one
+//! through a square root or a quotient may converge on a much shorter
+//! interval than the motion's (for a straight flight, about the distance
+//! from the instant to its closest approach to the centre): these models
+//! are the ones where a step chosen from the motion's series alone would
+//! search f's polynomial far outside its radius of convergence.
+//!
+//! The models are interpreted (`dalembert simulate FILE`'s route; its
+//! series are the generated code's, bit for bit: `tests/interpreted.rs`).
+//! Uses the symbolic engine: run one test at a time (`RUST_TEST_THREADS=1`).
+
+mod common;
+
+use std::path::Path;
+
+use dalembert::runtime::prelude::*;
+use dalembert::runtime::simulate::{
+    Collision, Integrator, Rk4, Settings, SimError, Simulator, State, Stats, Taylor,
+};
+use dalembert::runtime::taylor::{Coefficients, Series};
+use dalembert_codegen::interpret::Interpreted;
+
+use common::{dormand_prince, initial, lcg};
+
+/// The model file `tests/walls/{name}.toml`, interpreted.
+fn model<const N: usize>(name: &str) -> Interpreted<N> {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/walls")
+        .join(format!("{name}.toml"));
+    let d = dalembert_codegen::derive(&file).unwrap_or_else(|e| panic!("{name}: {e}"));
+    Interpreted::new(&d).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+/// How far beyond a wall a reported state may be: rounding (f at a
+/// collision is found to about 1e-16).
+const BEYOND: f64 = 1e-12;
+
+fn taylor(method: Taylor) -> Settings {
+    Settings {
+        integrator: Integrator::Taylor(method),
+        ..Settings::default()
+    }
+}
+
+fn rk4(step: f64) -> Settings {
+    Settings {
+        integrator: Integrator::Rk4(Rk4 { step }),
+        ..Settings::default()
+    }
+}
+
+/// The methods compared with the reference, each with how close its
+/// collision instants must come to it: Taylor's method at its default
+/// tolerance, at fixed orders 8 and 20 and at tolerance 1e-10;
+/// Dormand–Prince at rtol 1e-10; RK4 at a step of 1e-3.
+fn methods() -> Vec<(&'static str, Settings, f64)> {
+    let t = Taylor::default();
+    vec![
+        ("taylor", taylor(t), 1e-9),
+        (
+            "taylor order 8",
+            taylor(Taylor {
+                fixed_order: Some(8),
+                ..t
+            }),
+            1e-9,
+        ),
+        (
+            "taylor order 20",
+            taylor(Taylor {
+                fixed_order: Some(20),
+                ..t
+            }),
+            1e-9,
+        ),
+        (
+            "taylor 1e-10",
+            taylor(Taylor {
+                tolerance: 1e-10,
+                ..t
+            }),
+            1e-6,
+        ),
+        ("dormand-prince 1e-10", dormand_prince(1e-10), 1e-6),
+        ("rk4 1e-3", rk4(1e-3), 1e-6),
+    ]
+}
+
+/// A run of `m` from `start` to `t_end`: its collisions and counters.
+/// Asserts that no step ends beyond a wall (f ≥ −[`BEYOND`] at every
+/// step's state and at every collision, which is on its wall) and that the
+/// energy is kept to `energy` relative.
+fn run<M: Surfaces<N>, const N: usize>(
+    m: &M,
+    start: State<N>,
+    settings: Settings,
+    t_end: f64,
+    energy: f64,
+) -> Result<(Vec<Collision<M::Wall, N>>, Stats), SimError<M::Wall>> {
+    let e0 = m.energy(&start.q, &start.v);
+    let scale = e0.abs().max(1.0);
+    let mut sim = Simulator::new(m, start, settings)?;
+    let mut found = Vec::new();
+    let mut last = start.t;
+    let stats = sim.run(t_end, |s| {
+        for &wall in m.walls() {
+            let f = m.surface(wall, &s.state.q);
+            assert!(
+                f >= -BEYOND,
+                "{}: at t = {} the state is beyond {} (f = {f:e}); {settings:?}",
+                m.name(),
+                s.state.t,
+                m.wall_name(wall)
+            );
+        }
+        if let Some(c) = s.collision {
+            let f = m.surface(c.wall, &c.q);
+            assert!(
+                f.abs() <= BEYOND,
+                "{}: collision off the wall at t = {}, f = {f:e}; {settings:?}",
+                m.name(),
+                c.t
+            );
+            found.push(c);
+        }
+        let de = (s.energy(m) - e0).abs() / scale;
+        assert!(
+            de <= energy,
+            "{}: energy off by {de:e} at t = {}",
+            m.name(),
+            s.state.t
+        );
+        assert!(
+            s.state.t > last || s.collision.is_some(),
+            "no progress at t = {last}"
+        );
+        last = s.state.t;
+        true
+    })?;
+    Ok((found, stats))
+}
+
+/// `m` from its model file's start (`g` set where given) by every method
+/// against Dormand–Prince at rtol 1e-13 over `t_end`: the same collisions
+/// at the same instants, at least `least` of them. Taylor's method at its
+/// default tolerance finds them on the walls' series alone (no step's end
+/// contradicts a wall's series).
+fn same_collisions<const N: usize>(name: &str, g: Option<f64>, t_end: f64, least: usize) {
+    compare::<N>(name, name, g, t_end, least, methods());
+}
+
+/// [`same_collisions`] by the given methods only, against Dormand–Prince
+/// at rtol 1e-13 on the model `reference` (the same motion and walls,
+/// written otherwise).
+fn compare<const N: usize>(
+    name: &str,
+    reference: &str,
+    g: Option<f64>,
+    t_end: f64,
+    least: usize,
+    methods: Vec<(&'static str, Settings, f64)>,
+) {
+    let (mut m, mut r) = (model::<N>(name), model::<N>(reference));
+    if let Some(g) = g {
+        assert!(m.set_parameter_named("g", g) && r.set_parameter_named("g", g));
+    }
+    let start = initial(&m);
+    let (reference, _) = run(&r, start, dormand_prince(1e-13), t_end, 1e-11).unwrap();
+    eprintln!("{name}, g = {g:?}: {} collisions", reference.len());
+    assert!(reference.len() >= least, "{name}: {}", reference.len());
+    for (what, settings, within) in methods {
+        let energy = if what.starts_with("rk4") { 1e-6 } else { 1e-8 };
+        let (found, stats) = run(&m, start, settings, t_end, energy)
+            .unwrap_or_else(|e| panic!("{name}, {what}: {e}"));
+        let worst = found
+            .iter()
+            .zip(&reference)
+            .map(|(a, b)| (a.t - b.t).abs())
+            .fold(0.0, f64::max);
+        eprintln!(
+            "  {what}: {} collisions, |Δt| ≤ {worst:.1e}, {} steps, {} direct",
+            found.len(),
+            stats.steps,
+            stats.direct_crossings
+        );
+        assert_eq!(found.len(), reference.len(), "{name}, {what}");
+        assert!(worst <= within, "{name}, {what}: |Δt| = {worst:e}");
+        if what == "taylor" {
+            assert_eq!(stats.direct_crossings, 0, "{name}: {stats:?}");
+        }
+    }
+}
+
+#[test]
+fn square_root_wall() {
+    // The case: over 10 s Dormand–Prince finds 6 collisions.
+    same_collisions::<2>("disk_sqrt", None, 10.0, 6);
+    same_collisions::<2>("disk_sqrt", Some(9.81), 10.0, 6);
+}
+
+#[test]
+fn quotient_wall() {
+    same_collisions::<2>("disk_quotient", None, 10.0, 6);
+    same_collisions::<2>("disk_quotient", Some(9.81), 10.0, 6);
+}
+
+#[test]
+fn logarithm_wall() {
+    same_collisions::<2>("disk_log", None, 10.0, 6);
+    same_collisions::<2>("disk_log", Some(9.81), 10.0, 6);
+}
+
+#[test]
+fn exponential_wall() {
+    same_collisions::<2>("oval_exp", None, 10.0, 6);
+    same_collisions::<2>("oval_exp", Some(9.81), 10.0, 6);
+}
+
+#[test]
+fn sine_wall() {
+    same_collisions::<2>("disk_sin", None, 10.0, 6);
+    same_collisions::<2>("disk_sin", Some(9.81), 10.0, 6);
+}
+
+/// Taylor's methods only: beyond the ring where f < 0 the tangent has a
+/// pole and is positive again, which a Runge–Kutta step's samples of f
+/// can jump (see `tests/walls/disk_tan.toml`; Dormand–Prince stops on it
+/// with a grazing contact at the pole). The reference is the same disk
+/// with its edge through a square root: the same circle, the same radial
+/// normal, so the same collisions.
+#[test]
+fn tangent_wall() {
+    compare::<2>("disk_tan", "disk_sqrt", None, 10.0, 6, taylor_methods());
+    compare::<2>(
+        "disk_tan",
+        "disk_sqrt",
+        Some(9.81),
+        10.0,
+        6,
+        taylor_methods(),
+    );
+}
+
+/// The Taylor rows of [`methods`].
+fn taylor_methods() -> Vec<(&'static str, Settings, f64)> {
+    let mut all = methods();
+    all.retain(|(what, _, _)| what.starts_with("taylor"));
+    all
+}
+
+/// A nonholonomic model (the sleigh's blade) and a holonomic one (the
+/// pendulum's rod), each with a wall through a square root.
+#[test]
+fn constrained_models_with_a_square_root_wall() {
+    same_collisions::<3>("sleigh_rink", None, 10.0, 4);
+    same_collisions::<3>("sleigh_rink", Some(1.0), 10.0, 4);
+    same_collisions::<2>("pendulum_peg", None, 10.0, 6);
+}
+
+/// Random starts inside each domain (at least 0.05 from its wall, with
+/// velocities of size up to 3, on the constraints), with and without
+/// gravity, by every method for 3 s: no state outside, ever. Runs that
+/// stop with a typed error (a grazing contact) are allowed; none has so far.
+#[test]
+fn no_state_outside_from_random_starts() {
+    fn starts<const N: usize>(
+        m: &Interpreted<N>,
+        seed: u64,
+        count: usize,
+        admissible: impl Fn(&mut dyn FnMut() -> f64) -> State<N>,
+    ) -> Vec<State<N>> {
+        let mut state = seed;
+        let mut uniform = move || lcg(&mut state);
+        let mut out = Vec::new();
+        while out.len() < count {
+            let s = admissible(&mut uniform);
+            if m.walls().iter().all(|&w| m.surface(w, &s.q) > 0.05) {
+                out.push(s);
+            }
+        }
+        out
+    }
+    let plane = |u: &mut dyn FnMut() -> f64| State {
+        t: 0.0,
+        q: [2.0 * u() - 1.0, 2.0 * u() - 1.0],
+        v: [6.0 * u() - 3.0, 6.0 * u() - 3.0],
+    };
+    let (mut runs, mut stopped, mut collisions) = (0, 0, 0);
+    let mut tally = |outcome: Result<usize, String>| match outcome {
+        Ok(n) => {
+            runs += 1;
+            collisions += n;
+        }
+        Err(e) => {
+            eprintln!("stopped: {e}");
+            stopped += 1;
+        }
+    };
+    fn each<M: Surfaces<N>, const N: usize>(
+        m: &M,
+        start: State<N>,
+        tally: &mut impl FnMut(Result<usize, String>),
+    ) {
+        let taylor_only = m.name() == "disk_tan";
+        for (what, settings, _) in methods() {
+            if taylor_only && !what.starts_with("taylor") {
+                continue;
+            }
+            let outcome = run(m, start, settings, 3.0, 1e-5);
+            tally(
+                outcome
+                    .map(|(c, _)| c.len())
+                    .map_err(|e| format!("{what}: {e}")),
+            );
+        }
+    }
+    for name in [
+        "disk_sqrt",
+        "disk_quotient",
+        "disk_log",
+        "oval_exp",
+        "disk_sin",
+        "disk_tan",
+    ] {
+        let mut m = model::<2>(name);
+        for (seed, g) in [(1, 0.0), (2, 9.81)] {
+            assert!(m.set_parameter_named("g", g));
+            for start in starts(&m, seed, 6, plane) {
+                each(&m, start, &mut tally);
+            }
+        }
+    }
+    let sleigh = model::<3>("sleigh_rink");
+    let on_blade = |u: &mut dyn FnMut() -> f64| {
+        let (phi, speed) = (6.3 * u(), 6.0 * u() - 3.0);
+        State {
+            t: 0.0,
+            q: [2.0 * u() - 1.0, 2.0 * u() - 1.0, phi],
+            v: [speed * phi.cos(), speed * phi.sin(), 4.0 * u() - 2.0],
+        }
+    };
+    for start in starts(&sleigh, 3, 6, on_blade) {
+        each(&sleigh, start, &mut tally);
+    }
+    let pendulum = model::<2>("pendulum_peg");
+    let on_rod = |u: &mut dyn FnMut() -> f64| {
+        let (angle, speed) = (6.3 * u(), 12.0 * u() - 6.0);
+        State {
+            t: 0.0,
+            q: [angle.sin(), -angle.cos()],
+            v: [speed * angle.cos(), speed * angle.sin()],
+        }
+    };
+    for start in starts(&pendulum, 4, 6, on_rod) {
+        each(&pendulum, start, &mut tally);
+    }
+    eprintln!("{runs} runs with {collisions} collisions, {stopped} stopped");
+    assert!(
+        runs >= 450 && collisions >= 2000,
+        "{runs} runs, {collisions} collisions"
+    );
+    assert!(stopped * 50 <= runs, "{stopped} of {runs} runs stopped");
+}
+
+/// The last line of defence, alone: a model whose wall series says the
+/// wall is 1/2 further out than f does (the unit disk's f + 1/2). Taylor's
+/// method must not follow the series through the wall: every step's end
+/// is checked against f itself, and the crossings are found by f along the
+/// step, at Dormand–Prince's instants.
+#[test]
+fn a_wall_series_that_misleads_is_overruled_by_f() {
+    let disk = model::<2>("disk_sqrt");
+    let misled = Misled(&disk);
+    let start = initial(&disk);
+    let (reference, _) = run(&disk, start, dormand_prince(1e-13), 10.0, 1e-11).unwrap();
+    let (found, stats) = run(&misled, start, taylor(Taylor::default()), 10.0, 1e-8).unwrap();
+    eprintln!("{} collisions, {stats:?}", found.len());
+    assert_eq!(found.len(), reference.len());
+    assert!(stats.direct_crossings >= found.len() as u64, "{stats:?}");
+    for (a, b) in found.iter().zip(&reference) {
+        assert!((a.t - b.t).abs() <= 1e-9, "{} vs {}", a.t, b.t);
+    }
+}
+
+/// The disk model with its wall's series shifted by +1/2.
+struct Misled<'a>(&'a Interpreted<2>);
+
+type Wall = <Interpreted<2> as Walls<2, 2>>::Wall;
+
+impl Model<2, 2> for Misled<'_> {
+    fn name(&self) -> &str {
+        self.0.name()
+    }
+    fn coordinate_names(&self) -> &[&str] {
+        self.0.coordinate_names()
+    }
+    fn velocity_names(&self) -> &[&str] {
+        self.0.velocity_names()
+    }
+    fn parameter_names(&self) -> &[&str] {
+        self.0.parameter_names()
+    }
+    fn parameter(&self, index: usize) -> Option<f64> {
+        self.0.parameter(index)
+    }
+    fn set_parameter(&mut self, _: usize, _: f64) -> bool {
+        false
+    }
+    fn mass_matrix(&self, q: &[f64; 2]) -> [[f64; 2]; 2] {
+        self.0.mass_matrix(q)
+    }
+    fn kinetic_energy(&self, q: &[f64; 2], v: &[f64; 2]) -> f64 {
+        self.0.kinetic_energy(q, v)
+    }
+    fn constraints(&self, q: &[f64; 2]) -> dalembert::runtime::Rows<2> {
+        self.0.constraints(q)
+    }
+}
+
+impl Walls<2, 2> for Misled<'_> {
+    type Wall = Wall;
+    fn walls(&self) -> &[Wall] {
+        self.0.walls()
+    }
+    fn wall_name(&self, wall: Wall) -> &str {
+        self.0.wall_name(wall)
+    }
+    fn wall_rows(&self, wall: Wall, q: &[f64; 2]) -> dalembert::runtime::Rows<2> {
+        self.0.wall_rows(wall, q)
+    }
+    fn projector(&self, wall: Wall, q: &[f64; 2]) -> [[f64; 2]; 2] {
+        self.0.projector(wall, q)
+    }
+    fn collide(&self, wall: Wall, q: &[f64; 2], v: &[f64; 2]) -> [f64; 2] {
+        self.0.collide(wall, q, v)
+    }
+    fn normal(&self, wall: Wall, q: &[f64; 2]) -> [f64; 2] {
+        self.0.normal(wall, q)
+    }
+    fn normal_velocity(&self, wall: Wall, q: &[f64; 2], v: &[f64; 2]) -> f64 {
+        self.0.normal_velocity(wall, q, v)
+    }
+}
+
+impl Dynamics<2> for Misled<'_> {
+    fn potential(&self, q: &[f64; 2]) -> f64 {
+        self.0.potential(q)
+    }
+    fn forcing(&self, q: &[f64; 2], v: &[f64; 2]) -> [f64; 2] {
+        self.0.forcing(q, v)
+    }
+    fn constraint_drift(&self, q: &[f64; 2], v: &[f64; 2]) -> [f64; 2] {
+        self.0.constraint_drift(q, v)
+    }
+    fn closed_form_accelerations(&self, q: &[f64; 2], v: &[f64; 2]) -> Option<[f64; 2]> {
+        self.0.closed_form_accelerations(q, v)
+    }
+    type SeriesScratch = <Interpreted<2> as Dynamics<2>>::SeriesScratch;
+    fn taylor_series(
+        &self,
+        s: &mut Series<2>,
+        scratch: &mut Self::SeriesScratch,
+        order: usize,
+    ) -> bool {
+        self.0.taylor_series(s, scratch, order)
+    }
+}
+
+impl Surfaces<2> for Misled<'_> {
+    fn surface(&self, wall: Wall, q: &[f64; 2]) -> f64 {
+        self.0.surface(wall, q)
+    }
+    fn surface_series(
+        &self,
+        wall: Wall,
+        s: &Series<2>,
+        scratch: &mut Self::SeriesScratch,
+        out: &mut Coefficients,
+    ) -> bool {
+        let done = self.0.surface_series(wall, s, scratch, out);
+        out[0] += 0.5;
+        done
+    }
+}
