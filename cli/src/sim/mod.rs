@@ -11,8 +11,8 @@ use dalembert::for_each_model;
 use dalembert::models::*;
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
-    DormandPrince, Integrator, Residual, Rk4, Settings, Simulator, State, Taylor, admissible,
-    residual,
+    DormandPrince, Integrator, Residual, Rk4, Settings, SimError, Simulator, State, Taylor,
+    admissible, residual,
 };
 use dalembert::runtime::taylor::MAX_ORDER;
 use dalembert_codegen::Derivation;
@@ -22,8 +22,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use crate::plot::plot;
 
 mod output;
-use output::Output;
 pub use output::Row;
+use output::{MAX_ROWS, Output};
 
 /// The integration method.
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -192,10 +192,8 @@ fn simulate_file(args: &SimulateArgs) -> Result<bool, String> {
     sizes!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16)
 }
 
-/// Most rows a run may write (CSV rows at the `--every` spacing).
-const MAX_ROWS: f64 = 1e7;
-/// Most fixed steps a run may take.
-const MAX_STEPS: f64 = 1e10;
+/// Most fixed steps a run may take (about 100 s of RK4 on a small model).
+const MAX_STEPS: f64 = 1e9;
 
 /// The run's settings checked before anything runs: finite, positive and
 /// within bounds that keep time and output reasonable.
@@ -212,7 +210,7 @@ fn checked_spacing(args: &SimulateArgs) -> Result<f64, String> {
     positive("--t-end", args.t_end)?;
     let every = args.every.unwrap_or(args.t_end / 2000.0);
     positive("--every", every)?;
-    if args.t_end / every > MAX_ROWS {
+    if args.t_end / every > MAX_ROWS as f64 {
         return Err(format!(
             "--t-end {:?} with --every {every:?} would write {:.1e} rows; the limit is {MAX_ROWS:.0e}: raise --every",
             args.t_end,
@@ -232,7 +230,7 @@ fn checked_spacing(args: &SimulateArgs) -> Result<f64, String> {
     match args.integrator {
         Method::Rk4 => {
             positive("--step", args.step)?;
-            if args.t_end / args.step > MAX_STEPS {
+            if args.t_end / args.step >= MAX_STEPS {
                 return Err(format!(
                     "--t-end {:?} with --step {:?} would take {:.1e} steps; the limit is {MAX_STEPS:.0e}",
                     args.t_end,
@@ -294,7 +292,8 @@ fn run<M: Surfaces<N>, const N: usize>(
             "the initial energy is {e0}: the initial state is out of range for f64"
         ));
     }
-    let mut sim = Simulator::new(&model, start, settings(args)).map_err(|e| e.to_string())?;
+    let named = |e: SimError<M::Wall>| e.map_wall(|w| model.wall_name(w)).to_string();
+    let mut sim = Simulator::new(&model, start, settings(args)).map_err(named)?;
     std::fs::create_dir_all(&args.out)
         .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
     let csv = args.out.join(format!("{}.csv", model.name()));
@@ -444,7 +443,7 @@ fn integrate<M: Surfaces<N>, const N: usize>(
         let step = match sim.step(if dense { t_end } else { grid(k) }) {
             Ok(step) => step,
             Err(e) => {
-                failure = Some(e.to_string());
+                failure = Some(e.map_wall(|w| model.wall_name(w)).to_string());
                 break;
             }
         };
@@ -525,10 +524,16 @@ fn summary<M: Surfaces<N>, const N: usize>(
         stats.steps as f64 / secs,
         stats.collisions as f64 / secs
     );
+    // A relative figure means nothing where E₀ = 0 (a system at rest at
+    // zero potential, or one whose T and V cancel).
+    let relative = if e0 == 0.0 {
+        String::new()
+    } else {
+        format!(" (relative {:.2e})", out.drift / e0.abs())
+    };
     println!(
-        "  energy {e0:.12} at the start; largest |E − E₀| over the rows = {:.2e} (relative {:.2e})",
-        out.drift,
-        out.drift / e0.abs().max(f64::MIN_POSITIVE)
+        "  energy {e0:.12} at the start; largest |E − E₀| over the rows = {:.2e}{relative}",
+        out.drift
     );
     println!(
         "  largest constraint residuals over the rows: |A q̇| = {:.2e}, |h(q)| = {:.2e}",

@@ -32,6 +32,11 @@ impl<const N: usize> Row<N> {
     }
 }
 
+/// Most rows a run may write, collisions' rows included (about 1.5 GB of
+/// CSV for a model with 6 coordinates): a run that reaches it stops with
+/// an error saying so, the rows so far written.
+pub(super) const MAX_ROWS: usize = 10_000_000;
+
 /// Rows kept in memory for the plot (up to twice this many); the CSV has
 /// them all.
 const PLOT_ROWS: usize = 4000;
@@ -93,6 +98,13 @@ impl<const N: usize> Output<N> {
     }
 
     pub(super) fn push(&mut self, r: Row<N>) -> Result<(), String> {
+        if self.written >= MAX_ROWS {
+            return Err(format!(
+                "stopped at t = {}: the run has written {MAX_ROWS} rows to {} (collisions count as rows), the most a run may write; raise --every or shorten --t-end",
+                r.t,
+                self.path.display()
+            ));
+        }
         let mut line = String::new();
         let _ = write!(line, "{:e}", r.t);
         for x in r.q.iter().chain(&r.v) {
