@@ -192,32 +192,7 @@ fn every_generated_file_compiles() {
         lib.push_str(&format!("#[path = \"m{k}.rs\"]\npub mod m{k};\n"));
     }
     std::fs::write(dir.join("lib.rs"), lib).unwrap();
-    let deps = std::env::current_exe()
-        .unwrap()
-        .parent()
-        .unwrap()
-        .to_path_buf();
-    let out = Command::new(std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into()))
-        .args([
-            "--edition",
-            "2024",
-            "--crate-type",
-            "lib",
-            "--crate-name",
-            "generated_names",
-        ])
-        .arg("-L")
-        .arg(format!("dependency={}", deps.display()))
-        .arg("--extern")
-        .arg(format!(
-            "dalembert_runtime={}",
-            runtime_rlib(&deps).display()
-        ))
-        .arg("--out-dir")
-        .arg(&dir)
-        .arg(dir.join("lib.rs"))
-        .output()
-        .expect("rustc runs");
+    let out = compile(&dir, "generated_names");
     let stderr = String::from_utf8_lossy(&out.stderr);
     if !out.status.success() {
         // Name the first model file whose module has an error.
@@ -227,4 +202,88 @@ fn every_generated_file_compiles() {
             .unwrap_or_default();
         panic!("a generated file does not compile:\n{first}\n\n{stderr}");
     }
+}
+
+/// rustc on `dir/lib.rs` as a library crate against the runtime.
+fn compile(dir: &Path, crate_name: &str) -> std::process::Output {
+    let deps = std::env::current_exe()
+        .unwrap()
+        .parent()
+        .unwrap()
+        .to_path_buf();
+    Command::new(std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into()))
+        .args(["--edition", "2024", "--crate-type", "lib", "--crate-name"])
+        .arg(crate_name)
+        .arg("-L")
+        .arg(format!("dependency={}", deps.display()))
+        .arg("--extern")
+        .arg(format!(
+            "dalembert_runtime={}",
+            runtime_rlib(&deps).display()
+        ))
+        .arg("--out-dir")
+        .arg(dir)
+        .arg(dir.join("lib.rs"))
+        .output()
+        .expect("rustc runs")
+}
+
+/// Text from the model file reaches generated code only as inert comment
+/// text: a file name with line breaks and code in it, and docs with CR,
+/// `*/`, control characters, a line separator and bidirectional overrides
+/// and isolates (which rustc denies in comments), generate a file that
+/// compiles and defines nothing of theirs.
+#[test]
+fn text_from_the_model_file_stays_inert() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("generated-text");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let hostile =
+        r#"a\rb */ c /* d \u0007 e \u2028 f \u202E g \u2066 h \u2069 \r\npub fn injected_doc() {}"#;
+    let text = format!(
+        r#"[model]
+name = "inert"
+doc = "{hostile}"
+
+[parameters]
+m = {{ value = "1", doc = "{hostile}" }}
+
+[coordinates]
+names = ["x"]
+
+[dynamics]
+kinetic_energy = "m/2*x_dot^2"
+
+[[wall]]
+name = "wall"
+doc = "{hostile}"
+surface = "x"
+"#
+    );
+    let file = dir.join("inj\r\npub fn injected() {}\n\u{202e}.toml");
+    std::fs::write(&file, text).unwrap();
+    let code = dalembert_codegen::generate(&file).unwrap();
+    for line in code.lines() {
+        let code_part = line.trim_start();
+        assert!(
+            !code_part.starts_with("pub fn injected"),
+            "a line of the model file's became code:\n{code}"
+        );
+        assert!(
+            !line.contains('\r') && !line.contains('\u{202e}'),
+            "{line:?}"
+        );
+    }
+    std::fs::write(dir.join("m.rs"), &code).unwrap();
+    std::fs::write(
+        dir.join("lib.rs"),
+        "#![allow(dead_code)]\n#[path = \"m.rs\"]\npub mod m;\n",
+    )
+    .unwrap();
+    let out = compile(&dir, "generated_text");
+    assert!(
+        out.status.success(),
+        "{}\n\n{code}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
