@@ -10,7 +10,7 @@ use super::events::SeriesStep;
 use super::integrator::{Plan, Reach};
 use super::phase::Phase;
 use super::thresholds::{
-    POLISH_STEPS, SERIES_CHECK, SERIES_ROOT_ITERATIONS, SERIES_SAMPLES, TAYLOR_REACH,
+    ON_WALL_ULPS, POLISH_STEPS, SERIES_CHECK, SERIES_ROOT_ITERATIONS, SERIES_SAMPLES, TAYLOR_REACH,
     step_too_small,
 };
 use super::{SimError, Simulator, State, Step};
@@ -295,7 +295,9 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         };
         let mut y = finite(self.series.state(end), t0)?;
         let agreed = self.agrees(found, &y.0, &y.1, limit.plan.method.tolerance);
-        if let (Some(c), Some(f)) = (found, agreed) {
+        if let (Some(c), Some(f)) = (found, agreed)
+            && libm::fabs(f) > ON_WALL_ULPS * f64::EPSILON * c.scale
+        {
             (end, y) = self.onto_wall(c.wall, c.tau, y, f);
             found = Some(Found { tau: end, ..c });
         }

@@ -76,5 +76,10 @@ pub const SERIES_SAMPLES: usize = 16;
 /// by f itself along the step.
 pub const SERIES_CHECK: f64 = 1e3;
 
+/// A collision found on a wall's series whose f, evaluated directly, is
+/// within this many ulps of max(1, |f₀|) is on the wall already (no
+/// Newton step on f is tried).
+pub const ON_WALL_ULPS: f64 = 4.0;
+
 /// Newton (or bisection) steps at most on the step's polynomial.
 pub const SERIES_ROOT_ITERATIONS: usize = 100;
