@@ -17,6 +17,28 @@ pub enum ErrorKind {
     /// The file cannot be read.
     #[error("cannot read the model file: {0}")]
     Io(String),
+    /// The path is not a regular file (a FIFO or a device would block the
+    /// reader or never end).
+    #[error("the model file is not a regular file but {0}: a model file is read whole")]
+    NotAFile(String),
+    /// The file is larger than a model file may be.
+    #[error("the model file is larger than {limit} bytes, the most a model file may be")]
+    TooLarge {
+        /// The limit, [`crate::ir::MAX_FILE_BYTES`].
+        limit: u64,
+    },
+    /// A part of an expression that names nothing (numbers, pi, e and
+    /// functions of them) is not a finite number, or is 0 where it divides.
+    #[error("`{text}` is {what}")]
+    UndefinedConstant {
+        /// The part, as written.
+        text: String,
+        /// What is wrong with its value.
+        what: String,
+    },
+    /// The file is not UTF-8 text (at the first byte that is not).
+    #[error("the model file is not valid UTF-8 here")]
+    NotUtf8,
     /// A name is not a usable identifier.
     #[error("`{name}` cannot be used as a name: {why}")]
     BadName {

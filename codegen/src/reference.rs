@@ -50,7 +50,21 @@ pub struct Difference {
     pub reference: String,
     /// The derived entry.
     pub derived: String,
+    /// Where the two are not shown equal symbolically but agree at random
+    /// points (within [`NUMERIC_AGREEMENT`]): how many points. Evidence,
+    /// not proof (an identity the symbolic reduction does not know, such
+    /// as sin 2φ = 2 sin φ cos φ).
+    pub numerically_equal: Option<usize>,
 }
+
+/// Random points at which a difference not shown to vanish symbolically
+/// is evaluated.
+pub const NUMERIC_POINTS: usize = 32;
+
+/// Two entries agree numerically where |a − b| ≤ this × max(1, |a|, |b|)
+/// at every random point where both are finite, and at least half the
+/// points are such.
+pub const NUMERIC_AGREEMENT: f64 = 1e-9;
 
 /// The outcome of a comparison.
 #[derive(Debug, Clone, PartialEq)]
@@ -66,7 +80,7 @@ pub struct Comparison {
 impl Reference {
     /// Reads a reference file.
     pub fn load(path: &Path) -> Result<Self, String> {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let text = crate::ir::read_source(path).map_err(|e| e.render())?;
         toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))
     }
 
@@ -227,6 +241,14 @@ impl Reference {
             .map(|(name, e)| (name.clone(), e.text.clone()))
             .collect();
         let same = |a: &str, b: &str| symbolic::same_with(a, b, &definitions);
+        let (names, points) = random_points(d);
+        let names: Vec<&str> = names.iter().map(String::as_str).collect();
+        // Not shown equal: at how many random points they agree, if at all.
+        let numerically = |a: &str, b: &str| -> Result<Option<usize>, String> {
+            let (worst, finite) =
+                symbolic::numeric_difference(a, b, &definitions, &names, &points)?;
+            Ok((worst <= NUMERIC_AGREEMENT && 2 * finite >= points.len()).then_some(finite))
+        };
         let mut projector = Vec::new();
         for i in 0..n {
             for j in 0..n {
@@ -235,6 +257,7 @@ impl Reference {
                     projector.push(Difference {
                         row: i,
                         col: j,
+                        numerically_equal: numerically(&reference, &derived_p[i][j])?,
                         reference,
                         derived: derived_p[i][j].clone(),
                     });
@@ -255,6 +278,7 @@ impl Reference {
                     collision.push(Difference {
                         row: i,
                         col: 0,
+                        numerically_equal: numerically(&r_sub, &c_sub)?,
                         reference: r.clone(),
                         derived: c.clone(),
                     });
@@ -267,4 +291,42 @@ impl Reference {
             has_collision: !self.collision.is_empty(),
         })
     }
+}
+
+/// The model's parameters, coordinates and velocities, and
+/// [`NUMERIC_POINTS`] random values of them: each parameter its file's
+/// value times a factor in [1/2, 2] (in [−1, 1] where the file's is 0), each
+/// coordinate in [−3/2, 3/2], each velocity in [−1, 1]; the same points on
+/// every run.
+fn random_points(d: &Derivation) -> (Vec<String>, Vec<Vec<f64>>) {
+    let m = &d.model;
+    let mut names: Vec<String> = m.params.iter().map(|p| p.name.clone()).collect();
+    names.extend(m.coordinates.iter().cloned());
+    names.extend(m.velocities.iter().cloned());
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut uniform = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let points = (0..NUMERIC_POINTS)
+        .map(|_| {
+            let mut x: Vec<f64> = m
+                .params
+                .iter()
+                .map(|p| {
+                    if p.value == 0.0 {
+                        2.0 * uniform() - 1.0
+                    } else {
+                        p.value * 2f64.powf(2.0 * uniform() - 1.0)
+                    }
+                })
+                .collect();
+            x.extend(m.coordinates.iter().map(|_| 3.0 * uniform() - 1.5));
+            x.extend(m.velocities.iter().map(|_| 2.0 * uniform() - 1.0));
+            x
+        })
+        .collect();
+    (names, points)
 }

@@ -21,6 +21,10 @@ fn atom(text: &str) -> Result<Atom, String> {
 /// expression.
 fn atom_with(text: &str, definitions: &HashMap<String, Atom>) -> Result<Atom, String> {
     let node = crate::ir::expr::parse(text).map_err(|e| format!("`{text}`: {}", e.message))?;
+    if let Some((span, what)) = node.constant_problem() {
+        let part = text.get(span).unwrap_or_default();
+        return Err(format!("`{text}`: `{part}` is {what}"));
+    }
     build(&node, definitions).map_err(|e| format!("`{text}`: {}", e.message))
 }
 
@@ -42,6 +46,38 @@ pub fn same_with(a: &str, b: &str, definitions: &[(String, String)]) -> Result<b
         defs.insert(name.clone(), value);
     }
     Ok(vanishes(&(atom_with(a, &defs)? - atom_with(b, &defs)?)))
+}
+
+/// `a` and `b` (with `definitions` as in [`same_with`]) evaluated at each
+/// of `points` (a value for each of `names`, in order): the largest
+/// |a − b| / max(1, |a|, |b|) over the points where both are finite, and
+/// how many points those were. For equalities the symbolic reduction does
+/// not prove (multiple angles, say), as evidence and not as proof.
+pub fn numeric_difference(
+    a: &str,
+    b: &str,
+    definitions: &[(String, String)],
+    names: &[&str],
+    points: &[Vec<f64>],
+) -> Result<(f64, usize), String> {
+    crate::lock::acquire()?;
+    let mut defs = HashMap::new();
+    for (name, text) in definitions {
+        let value = atom_with(text, &defs)?;
+        defs.insert(name.clone(), value);
+    }
+    let outputs = [atom_with(a, &defs)?, atom_with(b, &defs)?];
+    let inputs: Vec<Atom> = names.iter().map(|n| Atom::from(model_symbol(n))).collect();
+    let p = program(&outputs, &inputs)?;
+    let (mut worst, mut finite) = (0.0f64, 0);
+    for x in points {
+        let v = p.eval(x);
+        if v.iter().all(|y| y.is_finite()) {
+            finite += 1;
+            worst = worst.max((v[0] - v[1]).abs() / 1f64.max(v[0].abs()).max(v[1].abs()));
+        }
+    }
+    Ok((worst, finite))
 }
 
 /// Evaluates `expr` at the given values.

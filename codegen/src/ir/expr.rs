@@ -519,7 +519,9 @@ fn constant_value(node: &Node) -> Result<Rational, ParseError> {
     }
 }
 
+mod constant;
 mod walk;
+pub(crate) use walk::multinomial;
 
 #[cfg(test)]
 mod tests;

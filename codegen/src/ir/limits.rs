@@ -14,6 +14,72 @@ pub(super) const MAX_DEFINITIONS: usize = 1000;
 /// substituted.
 pub(super) const MAX_EXPANDED_SIZE: u64 = 200_000;
 
+/// Deepest nesting of an expression's tree once the definitions it uses
+/// are substituted (four times the parser's limit for one expression's
+/// text, [`super::expr::MAX_DEPTH`]): the derivation recurses through the
+/// substituted tree, and 1000 definitions each dividing by the next
+/// overflowed its stack.
+pub(crate) const MAX_EXPANDED_DEPTH: u64 = 4 * super::expr::MAX_DEPTH as u64;
+
+/// Most terms an expression may expand to as a polynomial (an upper bound:
+/// see [`super::expr::Node::terms`]), definitions substituted. The largest
+/// built-in model's are a few hundred; (x + y + z + u + w)^100, 4.6 million,
+/// ran past 120 s in derivation.
+pub(crate) const MAX_TERMS: u64 = 20_000;
+
+/// How an expression expands as a polynomial, for the bounds on its size:
+/// an upper bound on its terms (and on those of any part of it), and the
+/// atoms it is a polynomial in (the names it reaches through definitions,
+/// and its function applications and fractional powers).
+#[derive(Clone, Debug, Default)]
+pub(super) struct Expansion {
+    /// The bound on the expression's own terms.
+    pub terms: u64,
+    /// The bound on the terms of the largest part of it (itself included).
+    pub worst: u64,
+    names: std::collections::BTreeSet<String>,
+    applications: u64,
+}
+
+/// [`Expansion`] of `node` of polynomial degree at most `degree`, where
+/// `defs` holds each definition's: the product-and-power bound of
+/// [`Node::terms`](super::expr::Node::terms), capped by the number of
+/// monomials of that degree in its v atoms, C(degree + v, v) (a power of a
+/// sum of one variable has few terms however large the power).
+pub(super) fn expansion(
+    node: &super::expr::Node,
+    degree: u64,
+    defs: &std::collections::HashMap<&str, Expansion>,
+) -> Expansion {
+    let mut worst = 0;
+    let terms = node.terms(&|n| defs.get(n).map_or(1, |e| e.terms), &mut worst);
+    let mut names = std::collections::BTreeSet::new();
+    node.visit_names(&mut |n, _| match defs.get(n) {
+        Some(e) => names.extend(e.names.iter().cloned()),
+        None => {
+            names.insert(n.to_string());
+        }
+    });
+    let applications = node.applications(&|n| defs.get(n).map_or(0, |e| e.applications));
+    let atoms = (names.len() as u64).saturating_add(applications);
+    let monomials = super::expr::multinomial(atoms.saturating_add(1), degree as u128);
+    Expansion {
+        terms: terms.min(monomials),
+        worst: worst.min(monomials),
+        names,
+        applications,
+    }
+}
+
+/// `n` in words for a message: a saturated count is "more than 10¹⁹".
+pub(super) fn count(n: u64) -> String {
+    if n == u64::MAX {
+        "more than 10^19".into()
+    } else {
+        n.to_string()
+    }
+}
+
 /// Most coordinates (or velocities of an instantaneous model). Derivation
 /// grows about as the cube of their number: 64 coordinates with a diagonal
 /// T take 1.6 s and 128 take 16 s (`dalembert derive`, 2026-11-23), and

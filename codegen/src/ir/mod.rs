@@ -259,16 +259,55 @@ pub fn camel(name: &str) -> String {
         .collect()
 }
 
+/// The most bytes a model file may have: far above any model's (the
+/// built-in ones have a few KiB), so that a huge file or a device cannot
+/// make the reader use memory without bound.
+pub const MAX_FILE_BYTES: u64 = 1 << 20;
+
 /// Reads and validates the model file at `path`.
 pub fn load(path: &Path) -> Result<Model, ModelErrors> {
-    match std::fs::read_to_string(path) {
-        Ok(text) => parse(path, &text),
-        Err(e) => {
-            let mut c = Collector::new(path, "");
-            c.error(ErrorKind::Io(e.to_string()), None);
-            Err(c.into_errors())
-        }
+    let text = read_source(path)?;
+    parse(path, &text)
+}
+
+/// The text of the file at `path`, read whole: a regular file (a FIFO
+/// would block the reader, a device like /dev/zero never end) of at most
+/// [`MAX_FILE_BYTES`], in UTF-8 (else the error is located at the first
+/// byte that is not).
+pub fn read_source(path: &Path) -> Result<String, ModelErrors> {
+    use std::io::Read;
+    let fail = |text: &str, kind: ErrorKind, span: Option<Range<usize>>| {
+        let mut c = Collector::new(path, text);
+        c.error(kind, span);
+        c.into_errors()
+    };
+    let io = |e: std::io::Error| fail("", ErrorKind::Io(e.to_string()), None);
+    let kind = std::fs::metadata(path).map_err(io)?.file_type();
+    if !kind.is_file() {
+        let what = if kind.is_dir() {
+            "a directory"
+        } else if kind.is_symlink() {
+            "a broken link"
+        } else {
+            "a FIFO, socket or device"
+        };
+        return Err(fail("", ErrorKind::NotAFile(what.into()), None));
     }
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes))
+        .map_err(io)?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        let limit = MAX_FILE_BYTES;
+        return Err(fail("", ErrorKind::TooLarge { limit }, None));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        // The text up to the bad byte is as read, so positions in the
+        // lossy text are the file's.
+        let at = e.utf8_error().valid_up_to();
+        let text = String::from_utf8_lossy(e.as_bytes()).into_owned();
+        fail(&text, ErrorKind::NotUtf8, Some(at..at + 1))
+    })
 }
 
 /// Validates the model text `text` (read from `path`).
@@ -292,6 +331,8 @@ pub fn parse(path: &Path, text: &str) -> Result<Model, ModelErrors> {
         check_names(m, &mut cx);
         check_degrees(m, &mut cx);
         check_polynomial_in_velocities(m, &mut cx);
+        check_velocity_degrees(m, &mut cx);
+        check_constants(m, &mut cx);
     }
     match model {
         Some(m) => cx.finish(m),
@@ -327,14 +368,39 @@ fn check_names(model: &Model, cx: &mut Collector) {
 /// substituted, exceeds [`expr::MAX_DEGREE`].
 fn check_degrees(model: &Model, cx: &mut Collector) {
     let mut degree: HashMap<&str, u64> = HashMap::new();
+    let mut depth: HashMap<&str, u64> = HashMap::new();
+    let mut expanded: HashMap<&str, limits::Expansion> = HashMap::new();
+    let of = |table: &HashMap<&str, u64>, n: &str| table.get(n).copied().unwrap_or(1);
     for (name, e) in &model.definitions {
-        let d = e.node.degree(&|n| degree.get(n).copied().unwrap_or(1));
+        let d = e.node.degree(&|n| of(&degree, n));
         degree.insert(name, d);
+        depth.insert(name, e.node.depth(&|n| of(&depth, n)));
+        let x = limits::expansion(&e.node, d, &expanded);
+        expanded.insert(name, x);
     }
     let definitions = model.definitions.len();
     for e in model.expressions().skip(definitions) {
-        let d = e.node.degree(&|n| degree.get(n).copied().unwrap_or(1));
-        if d > expr::MAX_DEGREE {
+        let nesting = e.node.depth(&|n| of(&depth, n));
+        let d = e.node.degree(&|n| of(&degree, n));
+        let worst = limits::expansion(&e.node, d, &expanded).worst;
+        if nesting > limits::MAX_EXPANDED_DEPTH {
+            cx.error(
+                ErrorKind::Limit(format!(
+                    "the expression is nested {nesting} levels deep once the definitions it uses are substituted; the limit is {}",
+                    limits::MAX_EXPANDED_DEPTH
+                )),
+                Some(e.span.clone()),
+            );
+        } else if worst > limits::MAX_TERMS {
+            cx.error(
+                ErrorKind::Limit(format!(
+                    "the expression may expand to {} terms as a polynomial (definitions substituted); the limit is {}",
+                    limits::count(worst),
+                    limits::MAX_TERMS
+                )),
+                Some(e.span.clone()),
+            );
+        } else if d > expr::MAX_DEGREE {
             cx.error(
                 ErrorKind::Limit(format!(
                     "the expression reaches polynomial degree {d}; the limit is {}",
@@ -367,6 +433,65 @@ fn check_polynomial_in_velocities(model: &Model, cx: &mut Collector) {
             cx.error(
                 ErrorKind::VelocityNotPolynomial { name, place },
                 Some(e.at(&span)),
+            );
+        }
+    }
+}
+
+/// Reports every expression with a constant part (one that names
+/// nothing) that is not a finite number or is 0 where it divides, as
+/// [`Node::constant_problem`](expr::Node::constant_problem) finds it: emitted
+/// code would compute NaN, an infinity or a huge number there.
+fn check_constants(model: &Model, cx: &mut Collector) {
+    for e in model.expressions() {
+        if let Some((span, what)) = e.node.constant_problem() {
+            let text = e.text.get(span.clone()).unwrap_or_default().to_string();
+            cx.error(
+                ErrorKind::UndefinedConstant { text, what },
+                Some(e.at(&span)),
+            );
+        }
+    }
+}
+
+/// Reports T of degree above 2 in the velocities as written, and
+/// constraint, contact and normal-velocity rows of degree above 1 (counted
+/// through definitions), before the derivation expands anything: the
+/// exact checks of those degrees come later, but the expansion of a
+/// product of squared sums alone can take tens of gigabytes (a T of degree
+/// 4 in chain_3's velocities did).
+fn check_velocity_degrees(model: &Model, cx: &mut Collector) {
+    let mut degree: HashMap<&str, u64> = model.velocities.iter().map(|v| (v.as_str(), 1)).collect();
+    for (name, e) in &model.definitions {
+        let d = e.node.degree_in(&|n| degree.get(n).copied().unwrap_or(0));
+        if d > 0 {
+            degree.insert(name, d);
+        }
+    }
+    let of = |e: &Expr| e.node.degree_in(&|n| degree.get(n).copied().unwrap_or(0));
+    let d = of(&model.kinetic_energy);
+    if d > 2 {
+        cx.error(
+            ErrorKind::NotQuadratic(format!(
+                "as written it has terms of degree {d} in the velocities"
+            )),
+            Some(model.kinetic_energy.span.clone()),
+        );
+    }
+    let rows = model.constraints.iter().chain(
+        model
+            .walls
+            .iter()
+            .flat_map(|w| w.normal_velocity.iter().chain(w.contact.iter())),
+    );
+    for e in rows {
+        let d = of(e);
+        if d > 1 {
+            cx.error(
+                ErrorKind::NotLinear(format!(
+                    "as written it has terms of degree {d} in the velocities"
+                )),
+                Some(e.span.clone()),
             );
         }
     }

@@ -9,7 +9,7 @@ use toml::Spanned;
 
 use super::expr::MAX_DEGREE;
 use super::file::{File, Names, Number, ParamDecl, WallDecl};
-use super::limits::{self, MAX_DEFINITIONS, MAX_EXPANDED_SIZE};
+use super::limits::{self, MAX_DEFINITIONS, MAX_EXPANDED_DEPTH, MAX_EXPANDED_SIZE, MAX_TERMS};
 use super::number::rational;
 use super::order::{dependency_order, reaches};
 use super::{Expr, GENERATED_TYPE_NAMES, Kind, Model, Param, ProjectorMode, Wall, camel};
@@ -351,12 +351,30 @@ impl Validator<'_> {
             }
         }
         let order = dependency_order(&uses);
-        let (mut size, mut degree) = (vec![1u64; exprs.len()], vec![1u64; exprs.len()]);
+        let ones = || vec![1u64; exprs.len()];
+        let (mut size, mut degree, mut depth) = (ones(), ones(), ones());
+        let mut expanded: HashMap<&str, limits::Expansion> = HashMap::new();
         for &i in &order {
             let lookup = |table: &[u64], n: &str| index.get(n).map_or(1, |&j| table[j]);
             size[i] = exprs[i].node.size(&|n| lookup(&size, n));
             degree[i] = exprs[i].node.degree(&|n| lookup(&degree, n));
-            let over = if size[i] > MAX_EXPANDED_SIZE {
+            depth[i] = exprs[i].node.depth(&|n| lookup(&depth, n));
+            let e = limits::expansion(&exprs[i].node, degree[i], &expanded);
+            let worst = e.worst;
+            expanded.insert(names[i].get_ref(), e);
+            let over = if depth[i] > MAX_EXPANDED_DEPTH {
+                Some(format!(
+                    "definition `{}` is nested {} levels deep once the definitions it uses are substituted; the limit is {MAX_EXPANDED_DEPTH}",
+                    names[i].get_ref(),
+                    depth[i]
+                ))
+            } else if worst > MAX_TERMS {
+                Some(format!(
+                    "definition `{}` may expand to {} terms as a polynomial once the definitions it uses are substituted; the limit is {MAX_TERMS}",
+                    names[i].get_ref(),
+                    limits::count(worst)
+                ))
+            } else if size[i] > MAX_EXPANDED_SIZE {
                 Some(format!(
                     "definition `{}` expands to more than {MAX_EXPANDED_SIZE} terms once the definitions it uses are substituted",
                     names[i].get_ref()
@@ -534,6 +552,12 @@ impl Validator<'_> {
                     )),
                     Some(e.at(&r)),
                 );
+                continue;
+            }
+            if let Some((r, what)) = e.node.constant_problem() {
+                let text = e.text.get(r.clone()).unwrap_or_default().to_string();
+                self.cx
+                    .error(ErrorKind::UndefinedConstant { text, what }, Some(e.at(&r)));
                 continue;
             }
             match e.node.value(&|k| env.get(k).copied()) {

@@ -65,6 +65,72 @@ impl Node {
         }
     }
 
+    /// Nesting depth, each name counting as `depth(name)` (so that a
+    /// definition counts as deep as what it stands for). Saturating.
+    pub fn depth(&self, depth: &dyn Fn(&str) -> u64) -> u64 {
+        match &self.kind {
+            NodeKind::Name(n) => depth(n),
+            NodeKind::Number(_) | NodeKind::Constant(_) => 1,
+            NodeKind::Sum(items) | NodeKind::Product(items) => items
+                .iter()
+                .map(|(_, x)| x.depth(depth))
+                .max()
+                .unwrap_or(0)
+                .saturating_add(1),
+            NodeKind::Neg(x) | NodeKind::Pow(x, _) | NodeKind::Call(_, x) => {
+                x.depth(depth).saturating_add(1)
+            }
+        }
+    }
+
+    /// An upper bound on the number of terms of the tree expanded as a
+    /// polynomial, each name counting as `terms(name)`: a sum adds, a
+    /// product multiplies, a whole power n of t terms has at most
+    /// C(n + t − 1, t − 1) (the multinomial's), and a function application
+    /// or a fractional power is one term. `worst` is raised to the largest
+    /// such bound met anywhere in the tree (a function's argument is
+    /// expanded too). Saturating.
+    pub fn terms(&self, terms: &dyn Fn(&str) -> u64, worst: &mut u64) -> u64 {
+        let own = match &self.kind {
+            NodeKind::Name(n) => terms(n),
+            NodeKind::Number(_) | NodeKind::Constant(_) => 1,
+            NodeKind::Sum(items) => items.iter().fold(0u64, |acc, (_, x)| {
+                acc.saturating_add(x.terms(terms, worst))
+            }),
+            NodeKind::Product(items) => items.iter().fold(1u64, |acc, (_, x)| {
+                acc.saturating_mul(x.terms(terms, worst))
+            }),
+            NodeKind::Neg(x) => x.terms(terms, worst),
+            NodeKind::Pow(x, n) if n.den == 1 => {
+                multinomial(x.terms(terms, worst), n.num.unsigned_abs())
+            }
+            NodeKind::Pow(x, _) | NodeKind::Call(_, x) => {
+                x.terms(terms, worst);
+                1
+            }
+        };
+        *worst = (*worst).max(own);
+        own
+    }
+
+    /// Function applications and fractional powers in the tree, each name
+    /// counting as `count(name)`: the atoms of its expansion besides the
+    /// names. Saturating.
+    pub fn applications(&self, count: &dyn Fn(&str) -> u64) -> u64 {
+        match &self.kind {
+            NodeKind::Name(n) => count(n),
+            NodeKind::Number(_) | NodeKind::Constant(_) => 0,
+            NodeKind::Sum(items) | NodeKind::Product(items) => {
+                items.iter().fold(0u64, |acc, (_, x)| {
+                    acc.saturating_add(x.applications(count))
+                })
+            }
+            NodeKind::Neg(x) => x.applications(count),
+            NodeKind::Pow(x, n) if n.den == 1 => x.applications(count),
+            NodeKind::Pow(x, _) | NodeKind::Call(_, x) => x.applications(count).saturating_add(1),
+        }
+    }
+
     /// The largest |numerator| or denominator of a number in the tree (at
     /// least 1; a denominator counts too, so that exp(x/0.00001) is bounded
     /// as exp(100000·x) is).
@@ -102,13 +168,42 @@ impl Node {
                 .fold(0u64, |acc, (_, x)| acc.saturating_add(x.degree(degree))),
             NodeKind::Neg(x) => x.degree(degree),
             // Exact arithmetic takes exp(k·x) for exp(x)^k: k multiplies.
-            NodeKind::Call(Function::Exp, x) => {
-                x.degree(degree).max(1).saturating_mul(x.largest_number())
-            }
+            // (exp of a constant is a constant, as any function's is.)
+            NodeKind::Call(Function::Exp, x) => match x.degree(degree) {
+                0 => 1,
+                d => d.saturating_mul(x.largest_number()),
+            },
             NodeKind::Call(_, x) => x.degree(degree).max(1),
             NodeKind::Pow(x, n) => x
                 .degree(degree)
                 .saturating_mul(n.num.unsigned_abs().min(u64::MAX as u128) as u64),
+        }
+    }
+
+    /// The degree as written in the names with a positive `degree(name)`,
+    /// the others taken as constants, for a tree that is a polynomial in
+    /// those names ([`Node::non_polynomial`] finds nothing): a divisor, a
+    /// function's argument or the base of a fractional or negative power is
+    /// then free of them and counts 0. An upper bound (terms that cancel
+    /// count). Saturating.
+    pub fn degree_in(&self, degree: &dyn Fn(&str) -> u64) -> u64 {
+        match &self.kind {
+            NodeKind::Name(n) => degree(n),
+            NodeKind::Number(_) | NodeKind::Constant(_) | NodeKind::Call(..) => 0,
+            NodeKind::Sum(items) => items
+                .iter()
+                .map(|(_, x)| x.degree_in(degree))
+                .max()
+                .unwrap_or(0),
+            NodeKind::Product(items) => items
+                .iter()
+                .filter(|(divide, _)| !divide)
+                .fold(0u64, |acc, (_, x)| acc.saturating_add(x.degree_in(degree))),
+            NodeKind::Neg(x) => x.degree_in(degree),
+            NodeKind::Pow(x, n) if n.den == 1 && n.num >= 0 => x
+                .degree_in(degree)
+                .saturating_mul(n.num.unsigned_abs().min(u64::MAX as u128) as u64),
+            NodeKind::Pow(..) => 0,
         }
     }
 
@@ -156,5 +251,67 @@ impl Node {
                 first(x).map(|name| (self.span.clone(), name, format!("inside {}(…)", f.name())))
             }
         }
+    }
+}
+
+/// C(n + t − 1, t − 1): the number of monomials of degree n in t variables
+/// (the terms of a sum of t terms raised to the power n), saturating at
+/// u64::MAX.
+pub(crate) fn multinomial(t: u64, n: u128) -> u64 {
+    if t <= 1 || n == 0 {
+        return 1;
+    }
+    // C(n + k, k) with k = min(t − 1, n), built as a product of fractions
+    // each of which leaves an integer.
+    let n = n.min(u64::MAX as u128) as u64;
+    let k = (t - 1).min(n);
+    let m = (t - 1).max(n);
+    let mut c: u128 = 1;
+    for i in 1..=k as u128 {
+        c = match c.checked_mul(m as u128 + i) {
+            Some(x) if x / i <= u64::MAX as u128 => x / i,
+            _ => return u64::MAX,
+        };
+    }
+    c as u64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::parse;
+    use super::multinomial;
+
+    #[test]
+    fn monomials_of_a_power_of_a_sum() {
+        assert_eq!(multinomial(1, 100), 1);
+        assert_eq!(multinomial(5, 0), 1);
+        assert_eq!(multinomial(2, 3), 4);
+        // (x+y+z+u+w)^100: C(104, 4).
+        assert_eq!(multinomial(5, 100), 4_598_126);
+        assert_eq!(multinomial(100, 5), multinomial(6, 99));
+        assert_eq!(multinomial(1000, 1000), u64::MAX);
+        assert_eq!(multinomial(u64::MAX, u128::MAX), u64::MAX);
+    }
+
+    #[test]
+    fn terms_and_depth_count_through_names() {
+        let terms = |text: &str| {
+            let mut worst = 0;
+            let own = parse(text)
+                .unwrap()
+                .terms(&|n| if n == "d" { 10 } else { 1 }, &mut worst);
+            (own, worst)
+        };
+        assert_eq!(terms("(x + y + z + u + w)^100"), (4_598_126, 4_598_126));
+        assert_eq!(terms("(x + y)*(x - y)"), (4, 4));
+        assert_eq!(terms("d^2"), (55, 55));
+        // A function's argument is expanded on its own.
+        assert_eq!(terms("sin((x + y)^3) + 1"), (2, 4));
+        assert_eq!(terms("sqrt(x^2 + y^2)"), (1, 2));
+        let depth = parse("1/(1 + d)")
+            .unwrap()
+            .depth(&|n| if n == "d" { 7 } else { 1 });
+        // Product → Sum → d (7 levels deep).
+        assert_eq!(depth, 9);
     }
 }
