@@ -95,6 +95,9 @@ fn methods() -> Vec<(&'static str, Settings, f64)> {
     ]
 }
 
+/// A run's collisions and counters, or the error that stopped it.
+type Outcome<W, const N: usize> = Result<(Vec<Collision<W, N>>, Stats), SimError<W>>;
+
 /// A run of `m` from `start` to `t_end`: its collisions and counters.
 /// Asserts that no step ends beyond a wall (f ≥ −[`BEYOND`] at every
 /// step's state and at every collision, which is on its wall) and that the
@@ -105,7 +108,7 @@ fn run<M: Surfaces<N>, const N: usize>(
     settings: Settings,
     t_end: f64,
     energy: f64,
-) -> Result<(Vec<Collision<M::Wall, N>>, Stats), SimError<M::Wall>> {
+) -> Outcome<M::Wall, N> {
     let e0 = m.energy(&start.q, &start.v);
     let scale = e0.abs().max(1.0);
     let mut sim = Simulator::new(m, start, settings)?;
@@ -268,8 +271,10 @@ fn constrained_models_with_a_square_root_wall() {
 
 /// Random starts inside each domain (at least 0.05 from its wall, with
 /// velocities of size up to 3, on the constraints), with and without
-/// gravity, by every method for 3 s: no state outside, ever. Runs that
-/// stop with a typed error (a grazing contact) are allowed; none has so far.
+/// gravity, by every method for 3 s (the tangent by Taylor's only): no
+/// state outside, ever. Runs that stop with a typed error (a grazing
+/// contact) are allowed, one in fifty at most; none did when this was
+/// written (480 runs, 2374 collisions).
 #[test]
 fn no_state_outside_from_random_starts() {
     fn starts<const N: usize>(

@@ -370,10 +370,13 @@ fn check_degrees(model: &Model, cx: &mut Collector) {
     let mut degree: HashMap<&str, u64> = HashMap::new();
     let mut depth: HashMap<&str, u64> = HashMap::new();
     let mut expanded: HashMap<&str, limits::Expansion> = HashMap::new();
+    let mut divisions: HashMap<&str, u64> = HashMap::new();
     let of = |table: &HashMap<&str, u64>, n: &str| table.get(n).copied().unwrap_or(1);
+    let nested = |table: &HashMap<&str, u64>, n: &str| table.get(n).copied().unwrap_or(0);
     for (name, e) in &model.definitions {
         let d = e.node.degree(&|n| of(&degree, n));
         degree.insert(name, d);
+        divisions.insert(name, e.node.nested_divisions(&|n| nested(&divisions, n)));
         depth.insert(name, e.node.depth(&|n| of(&depth, n)));
         let x = limits::expansion(&e.node, d, &expanded);
         expanded.insert(name, x);
@@ -383,7 +386,16 @@ fn check_degrees(model: &Model, cx: &mut Collector) {
         let nesting = e.node.depth(&|n| of(&depth, n));
         let d = e.node.degree(&|n| of(&degree, n));
         let worst = limits::expansion(&e.node, d, &expanded).worst;
-        if nesting > limits::MAX_EXPANDED_DEPTH {
+        let fractions = e.node.nested_divisions(&|n| nested(&divisions, n));
+        if fractions > limits::MAX_NESTED_DIVISIONS {
+            cx.error(
+                ErrorKind::Limit(format!(
+                    "the expression nests {fractions} divisions inside one another (definitions substituted); the limit is {}",
+                    limits::MAX_NESTED_DIVISIONS
+                )),
+                Some(e.span.clone()),
+            );
+        } else if nesting > limits::MAX_EXPANDED_DEPTH {
             cx.error(
                 ErrorKind::Limit(format!(
                     "the expression is nested {nesting} levels deep once the definitions it uses are substituted; the limit is {}",

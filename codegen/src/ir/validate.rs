@@ -9,7 +9,9 @@ use toml::Spanned;
 
 use super::expr::MAX_DEGREE;
 use super::file::{File, Names, Number, ParamDecl, WallDecl};
-use super::limits::{self, MAX_DEFINITIONS, MAX_EXPANDED_DEPTH, MAX_EXPANDED_SIZE, MAX_TERMS};
+use super::limits::{
+    self, MAX_DEFINITIONS, MAX_EXPANDED_DEPTH, MAX_EXPANDED_SIZE, MAX_NESTED_DIVISIONS, MAX_TERMS,
+};
 use super::number::rational;
 use super::order::{dependency_order, reaches};
 use super::{Expr, GENERATED_TYPE_NAMES, Kind, Model, Param, ProjectorMode, Wall, camel};
@@ -353,16 +355,26 @@ impl Validator<'_> {
         let order = dependency_order(&uses);
         let ones = || vec![1u64; exprs.len()];
         let (mut size, mut degree, mut depth) = (ones(), ones(), ones());
+        let mut divisions = vec![0u64; exprs.len()];
         let mut expanded: HashMap<&str, limits::Expansion> = HashMap::new();
         for &i in &order {
             let lookup = |table: &[u64], n: &str| index.get(n).map_or(1, |&j| table[j]);
             size[i] = exprs[i].node.size(&|n| lookup(&size, n));
             degree[i] = exprs[i].node.degree(&|n| lookup(&degree, n));
             depth[i] = exprs[i].node.depth(&|n| lookup(&depth, n));
+            divisions[i] = exprs[i]
+                .node
+                .nested_divisions(&|n| index.get(n).map_or(0, |&j| divisions[j]));
             let e = limits::expansion(&exprs[i].node, degree[i], &expanded);
             let worst = e.worst;
             expanded.insert(names[i].get_ref(), e);
-            let over = if depth[i] > MAX_EXPANDED_DEPTH {
+            let over = if divisions[i] > MAX_NESTED_DIVISIONS {
+                Some(format!(
+                    "definition `{}` nests {} divisions inside one another once the definitions it uses are substituted; the limit is {MAX_NESTED_DIVISIONS}",
+                    names[i].get_ref(),
+                    divisions[i]
+                ))
+            } else if depth[i] > MAX_EXPANDED_DEPTH {
                 Some(format!(
                     "definition `{}` is nested {} levels deep once the definitions it uses are substituted; the limit is {MAX_EXPANDED_DEPTH}",
                     names[i].get_ref(),

@@ -256,7 +256,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         let start = tau;
         for _ in 0..POLISH_STEPS {
             let nv = m.normal_velocity(wall, &y.0, &y.1);
-            if f == 0.0 || !(nv < 0.0) {
+            if f == 0.0 || nv.is_nan() || nv >= 0.0 {
                 break;
             }
             let next = tau - f / nv;
@@ -265,7 +265,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             }
             let candidate = self.series.state(next);
             let f_next = m.surface(wall, &candidate.0);
-            if !(libm::fabs(f_next) < libm::fabs(f)) {
+            if f_next.is_nan() || libm::fabs(f_next) >= libm::fabs(f) {
                 break;
             }
             (tau, y, f) = (next, candidate, f_next);

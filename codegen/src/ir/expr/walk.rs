@@ -113,6 +113,28 @@ impl Node {
         own
     }
 
+    /// The most divisions nested inside one another along a path of the
+    /// tree (a divisor or a negative power counts one), each name counting
+    /// as `nested(name)`. Saturating.
+    pub fn nested_divisions(&self, nested: &dyn Fn(&str) -> u64) -> u64 {
+        match &self.kind {
+            NodeKind::Name(n) => nested(n),
+            NodeKind::Number(_) | NodeKind::Constant(_) => 0,
+            NodeKind::Sum(items) | NodeKind::Product(items) => items
+                .iter()
+                .map(|(divide, x)| {
+                    x.nested_divisions(nested)
+                        .saturating_add(u64::from(*divide))
+                })
+                .max()
+                .unwrap_or(0),
+            NodeKind::Pow(x, n) if n.num < 0 => x.nested_divisions(nested).saturating_add(1),
+            NodeKind::Neg(x) | NodeKind::Pow(x, _) | NodeKind::Call(_, x) => {
+                x.nested_divisions(nested)
+            }
+        }
+    }
+
     /// Function applications and fractional powers in the tree, each name
     /// counting as `count(name)`: the atoms of its expansion besides the
     /// names. Saturating.
@@ -308,6 +330,15 @@ mod tests {
         // A function's argument is expanded on its own.
         assert_eq!(terms("sin((x + y)^3) + 1"), (2, 4));
         assert_eq!(terms("sqrt(x^2 + y^2)"), (1, 2));
+        let nested = |text: &str| {
+            parse(text)
+                .unwrap()
+                .nested_divisions(&|n| if n == "d" { 3 } else { 0 })
+        };
+        assert_eq!(nested("1/(1 + d)"), 4);
+        assert_eq!(nested("x/y + 1/z"), 1);
+        assert_eq!(nested("(1 + 1/x)^(-2)"), 2);
+        assert_eq!(nested("sin(1/x)*d"), 3);
         let depth = parse("1/(1 + d)")
             .unwrap()
             .depth(&|n| if n == "d" { 7 } else { 1 });
