@@ -64,6 +64,7 @@ mod events;
 pub mod integrator;
 mod phase;
 mod projection;
+mod roots;
 mod series;
 pub mod thresholds;
 mod types;
