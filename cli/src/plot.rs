@@ -23,7 +23,7 @@ fn range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
 pub fn plot<M: Surfaces<N>, const N: usize>(
     file: &Path,
     model: &M,
-    rows: &[Row<N>],
+    rows: &[Row<'_, N>],
     axes: (usize, usize),
     e0: f64,
 ) -> Result<(), String> {
@@ -46,7 +46,7 @@ fn text(e: impl std::fmt::Display) -> String {
 }
 
 /// The time range of the rows.
-fn times<const N: usize>(rows: &[Row<N>]) -> std::ops::Range<f64> {
+fn times<const N: usize>(rows: &[Row<'_, N>]) -> std::ops::Range<f64> {
     0.0..rows.last().map_or(1.0, |r| r.t.max(1e-12))
 }
 
@@ -54,7 +54,7 @@ fn times<const N: usize>(rows: &[Row<N>]) -> std::ops::Range<f64> {
 fn coordinates_panel<M: Surfaces<N>, const N: usize>(
     area: &Panel<'_>,
     model: &M,
-    rows: &[Row<N>],
+    rows: &[Row<'_, N>],
 ) -> Result<(), String> {
     let mut chart = ChartBuilder::on(area)
         .caption(format!("{}: coordinates", model.name()), ("sans-serif", 22))
@@ -84,7 +84,7 @@ fn coordinates_panel<M: Surfaces<N>, const N: usize>(
 fn path_panel<M: Surfaces<N>, const N: usize>(
     area: &Panel<'_>,
     model: &M,
-    rows: &[Row<N>],
+    rows: &[Row<'_, N>],
     (a, b): (usize, usize),
 ) -> Result<(), String> {
     let names = model.coordinate_names();
@@ -118,7 +118,11 @@ fn path_panel<M: Surfaces<N>, const N: usize>(
 }
 
 /// E − E₀ against time.
-fn energy_panel<const N: usize>(area: &Panel<'_>, rows: &[Row<N>], e0: f64) -> Result<(), String> {
+fn energy_panel<const N: usize>(
+    area: &Panel<'_>,
+    rows: &[Row<'_, N>],
+    e0: f64,
+) -> Result<(), String> {
     let mut energy = ChartBuilder::on(area)
         .caption(
             format!("energy drift E − E₀ (E₀ = {e0:.6})"),

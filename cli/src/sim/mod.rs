@@ -420,11 +420,11 @@ fn settings(args: &SimulateArgs) -> Settings {
 /// stops at the next row: the Runge–Kutta interpolants are an order below
 /// their steps (Dormand–Prince's rows on `chain_3` at the default
 /// tolerances: 5e-8 energy error against 5e-10 at step ends).
-fn integrate<M: Surfaces<N>, const N: usize>(
+fn integrate<'m, M: Surfaces<N>, const N: usize>(
     sim: &mut Simulator<'_, M, N>,
-    model: &M,
+    model: &'m M,
     (t_end, every, dense): (f64, f64, bool),
-    out: &mut Output<N>,
+    out: &mut Output<'m, N>,
 ) -> Result<Option<String>, String> {
     let bar = ProgressBar::new(1000);
     bar.set_style(
@@ -460,7 +460,7 @@ fn integrate<M: Surfaces<N>, const N: usize>(
         if let Some(c) = &step.collision {
             // The state just before the collision, from its record.
             out.push(Row {
-                event: Some(model.wall_name(c.wall).to_string()),
+                event: Some(model.wall_name(c.wall)),
                 ..Row::of(model, c.t, c.q, c.v_minus)
             })?;
         }
@@ -490,7 +490,7 @@ fn summary<M: Surfaces<N>, const N: usize>(
     sim: &Simulator<'_, M, N>,
     model: &M,
     args: &SimulateArgs,
-    out: &Output<N>,
+    out: &Output<'_, N>,
     e0: f64,
     secs: f64,
 ) {

@@ -1,23 +1,24 @@
 //! Where a run's rows go: the CSV file as they come, a thinned copy for the
 //! plot, and the largest energy drift and residuals over every row.
 
-use std::fmt::Write as _;
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::residual;
 
-/// One output row.
-pub struct Row<const N: usize> {
+/// One output row; `event` is the name of the wall met, on the row just
+/// before a collision.
+pub struct Row<'m, const N: usize> {
     pub t: f64,
     pub q: [f64; N],
     pub v: [f64; N],
     pub energy: f64,
     pub residual: [f64; 2],
-    pub event: Option<String>,
+    pub event: Option<&'m str>,
 }
 
-impl<const N: usize> Row<N> {
+impl<const N: usize> Row<'_, N> {
     /// The row of the state (q, v) at t, its energy and residuals computed.
     pub fn of<M: Surfaces<N>>(model: &M, t: f64, q: [f64; N], v: [f64; N]) -> Self {
         let r = residual(model, &q, &v);
@@ -43,13 +44,13 @@ const PLOT_ROWS: usize = 4000;
 
 /// Where the rows go: the CSV file as they come, a thinned copy for the
 /// plot, and the largest energy drift and residuals over every row.
-pub(super) struct Output<const N: usize> {
+pub(super) struct Output<'m, const N: usize> {
     file: std::io::BufWriter<std::fs::File>,
     path: PathBuf,
     /// Rows for the plot: every `stride`-th row of a state, and every
     /// `collision_stride`-th collision (each one while they take at most a
     /// quarter of the budget; see [`Output::thin`]).
-    pub(super) kept: Vec<Row<N>>,
+    pub(super) kept: Vec<Row<'m, N>>,
     stride: usize,
     collision_stride: usize,
     /// Rows written in all, and of them collisions.
@@ -60,7 +61,7 @@ pub(super) struct Output<const N: usize> {
     pub(super) worst: [f64; 2],
 }
 
-impl<const N: usize> Output<N> {
+impl<'m, const N: usize> Output<'m, N> {
     pub(super) fn create<M: Surfaces<N>>(model: &M, path: &Path, e0: f64) -> Result<Self, String> {
         let file = std::fs::File::create(path)
             .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
@@ -86,18 +87,17 @@ impl<const N: usize> Output<N> {
             header.push_str(name);
         }
         header.push_str(",energy,residual_velocity,residual_position,collision\n");
-        out.write(&header)?;
+        out.write(header.as_bytes())?;
         Ok(out)
     }
 
-    fn write(&mut self, text: &str) -> Result<(), String> {
-        use std::io::Write as _;
+    fn write(&mut self, text: &[u8]) -> Result<(), String> {
         self.file
-            .write_all(text.as_bytes())
+            .write_all(text)
             .map_err(|e| format!("cannot write {}: {e}", self.path.display()))
     }
 
-    pub(super) fn push(&mut self, r: Row<N>) -> Result<(), String> {
+    pub(super) fn push(&mut self, r: Row<'m, N>) -> Result<(), String> {
         if self.written >= MAX_ROWS {
             return Err(format!(
                 "stopped at t = {}: the run has written {MAX_ROWS} rows to {} (collisions count as rows), the most a run may write; raise --every or shorten --t-end",
@@ -105,19 +105,19 @@ impl<const N: usize> Output<N> {
                 self.path.display()
             ));
         }
-        let mut line = String::new();
-        let _ = write!(line, "{:e}", r.t);
-        for x in r.q.iter().chain(&r.v) {
-            let _ = write!(line, ",{x:e}");
+        // Each number in its shortest form that reads back exactly (Ryū:
+        // std's `{:e}` took most of a bouncing ball's run).
+        let mut number = ryu::Buffer::new();
+        let mut line = Vec::with_capacity(32 * (2 * N + 4));
+        line.extend_from_slice(number.format(r.t).as_bytes());
+        let values = (r.q.iter().chain(&r.v)).chain([&r.energy, &r.residual[0], &r.residual[1]]);
+        for &x in values {
+            line.push(b',');
+            line.extend_from_slice(number.format(x).as_bytes());
         }
-        let _ = writeln!(
-            line,
-            ",{:e},{:e},{:e},{}",
-            r.energy,
-            r.residual[0],
-            r.residual[1],
-            r.event.as_deref().unwrap_or("")
-        );
+        line.push(b',');
+        line.extend_from_slice(r.event.unwrap_or("").as_bytes());
+        line.push(b'\n');
         self.write(&line)?;
         self.drift = self.drift.max((r.energy - self.e0).abs());
         self.worst = [
@@ -166,7 +166,6 @@ impl<const N: usize> Output<N> {
     }
 
     pub(super) fn finish(&mut self) -> Result<(), String> {
-        use std::io::Write as _;
         self.file
             .flush()
             .map_err(|e| format!("cannot write {}: {e}", self.path.display()))
@@ -179,7 +178,7 @@ mod tests {
     use dalembert::models::PendulumWall;
 
     /// `rows` rows at t = 0, 1, …, a collision wherever `collision(t)`.
-    fn pushed(name: &str, rows: usize, collision: impl Fn(usize) -> bool) -> Output<2> {
+    fn pushed(name: &str, rows: usize, collision: impl Fn(usize) -> bool) -> Output<'static, 2> {
         let path = std::env::temp_dir().join(format!("dalembert-output-{name}.csv"));
         let mut out = Output::create(&PendulumWall::default(), &path, 0.0).unwrap();
         for t in 0..rows {
@@ -189,7 +188,7 @@ mod tests {
                 v: [0.0; 2],
                 energy: 0.0,
                 residual: [0.0; 2],
-                event: collision(t).then(|| "wall".to_string()),
+                event: collision(t).then_some("wall"),
             })
             .unwrap();
             assert!(
