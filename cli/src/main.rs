@@ -55,9 +55,8 @@ enum Command {
     Generate {
         /// The model file.
         file: PathBuf,
-        /// Where to write it (default: standard output). Prefer this to
-        /// redirecting standard output: symbolica prints its licence banner
-        /// there on first use.
+        /// Where to write it (default: standard output; symbolica's licence
+        /// notice goes to standard error).
         #[arg(short, long)]
         output: Option<PathBuf>,
         /// Emit f32 arithmetic (for microcontrollers without double-precision
@@ -99,7 +98,36 @@ fn main() -> ExitCode {
 }
 
 fn derive(file: &Path) -> Result<Derivation, String> {
-    dalembert_codegen::derive(file).map_err(|e: ModelErrors| e.render())
+    notices_to_stderr(|| dalembert_codegen::derive(file)).map_err(|e: ModelErrors| e.render())
+}
+
+/// Runs `f`, which may be the generator's first use of symbolica, with
+/// standard output sent to standard error. symbolica shows its licence
+/// notice on standard output when first used; there it would become the
+/// first lines of the Rust code, derivation or CSV summary a user
+/// redirects to a file. On standard error it is still shown.
+fn notices_to_stderr<T>(f: impl FnOnce() -> T) -> T {
+    use std::io::Write as _;
+    let _ = std::io::stdout().flush();
+    #[cfg(unix)]
+    // SAFETY: plain file-descriptor calls on this process's own standard
+    // streams; a failed `dup` leaves standard output as it was.
+    unsafe {
+        let saved = libc::dup(1);
+        if saved < 0 || libc::dup2(2, 1) < 0 {
+            if saved >= 0 {
+                libc::close(saved);
+            }
+            return f();
+        }
+        let out = f();
+        let _ = std::io::stdout().flush();
+        libc::dup2(saved, 1);
+        libc::close(saved);
+        out
+    }
+    #[cfg(not(unix))]
+    f()
 }
 
 /// `derive`: the derivation, then how long derivation and emission took.
@@ -122,11 +150,13 @@ fn derive_timed(file: &Path) -> Result<bool, String> {
 }
 
 fn generate(file: &Path, output: Option<&Path>, f32: bool) -> Result<bool, String> {
-    let code = if f32 {
-        dalembert_codegen::generate_f32(file)
-    } else {
-        dalembert_codegen::generate(file)
-    }
+    let code = notices_to_stderr(|| {
+        if f32 {
+            dalembert_codegen::generate_f32(file)
+        } else {
+            dalembert_codegen::generate(file)
+        }
+    })
     .map_err(|e| e.render())?;
     match output {
         Some(path) => std::fs::write(path, code).map_err(|e| format!("{}: {e}", path.display()))?,

@@ -167,7 +167,7 @@ fn simulate_file(args: &SimulateArgs) -> Result<bool, String> {
         return Err(format!("no model file {}", path.display()));
     }
     checked_spacing(args)?;
-    let d: Derivation = dalembert_codegen::derive(path).map_err(|e| e.render())?;
+    let d: Derivation = crate::derive(path)?;
     let n = d.model.velocities.len();
     macro_rules! sizes {
         ($($n:literal)*) => {
