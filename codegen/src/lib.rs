@@ -53,40 +53,75 @@ pub fn generate(path: &Path) -> Result<String, ModelErrors> {
 /// uses the runtime's f64 numerics).
 pub fn generate_with(path: &Path, options: Options) -> Result<String, ModelErrors> {
     let d = derive(path)?;
-    if options.scalar == Scalar::F32
-        && let Some(w) = d.walls.iter().find(|w| w.structured())
-    {
+    emittable(&d, options)?;
+    Ok(emit::file(&d, options))
+}
+
+/// Most instructions the generated functions of one model may have
+/// together. rustc's time grows about as the square of the code's size: a
+/// model whose G has every entry non-zero (T = ½m|q̇|² + ½k(Σ cos qᵢ q̇ᵢ)²)
+/// writes 7 300 instructions for 20 coordinates, which a debug build
+/// compiles in 2.6 s; 36 900 for 40 coordinates, 25 s and 0.7 GB; 104 900
+/// (7.1 MB of Rust) for 60 coordinates, 214 s and 1.7 GB (`rustc -C
+/// opt-level=0`; with `-C opt-level=3`, 271 s and 3.4 GB; 2026-12-05).
+/// This bound, about 48 such coordinates, keeps a debug build near a minute.
+pub const MAX_GENERATED_INSTRUCTIONS: usize = 60_000;
+
+/// That `d` can be emitted as `options` say, or the located reason why not:
+/// f32 needs a closed-form P and constants within its range, and the code
+/// must stay within [`MAX_GENERATED_INSTRUCTIONS`].
+fn emittable(d: &Derivation, options: Options) -> Result<(), ModelErrors> {
+    let refuse = |kind: ErrorKind, span: Option<std::ops::Range<usize>>| {
         let mut cx = diag::Collector::new(&d.model.file, &d.model.source);
-        let e = cx.error(
-            ErrorKind::Structure(format!(
-                "f32 generation needs a closed-form P, and wall `{}` is structured: set `projector = \"symbolic\"` under [model]",
-                w.name
-            )),
-            None,
-        );
-        return cx.conclude(Err(e));
-    }
-    if options.scalar == Scalar::F32 {
-        let functions = d
+        let e = cx.error(kind, span);
+        cx.conclude::<()>(Err(e))
+    };
+    let functions = || {
+        let model = d
             .functions
             .iter()
-            .chain(d.walls.iter().flat_map(|w| &w.functions));
-        let too_large = functions
-            .filter(|f| f.program.consts.iter().any(|c| c.abs() > f32::MAX as f64))
-            .map(|f| f.quantity.spec().name)
-            .next();
-        if let Some(name) = too_large {
-            let mut cx = diag::Collector::new(&d.model.file, &d.model.source);
-            let e = cx.error(
-                ErrorKind::Limit(format!(
-                    "a constant of `{name}` exceeds f32's range (about 3.4e38): generate f64 code"
+            .map(|f| (f, &d.model.kinetic_energy.span));
+        let walls = (d.walls.iter().zip(&d.model.walls))
+            .flat_map(|(w, declared)| w.functions.iter().map(|f| (f, &declared.span)));
+        model.chain(walls)
+    };
+    let total: usize = functions().map(|(f, _)| f.program.instrs.len()).sum();
+    if total > MAX_GENERATED_INSTRUCTIONS {
+        let (largest, span) = functions()
+            .max_by_key(|(f, _)| f.program.instrs.len())
+            .expect("code that large has functions");
+        return refuse(
+            ErrorKind::Limit(format!(
+                "the generated code would have {total} instructions, more than the {MAX_GENERATED_INSTRUCTIONS} a model's generated Rust may have (rustc's time grows about as the square of the code's size: a minute for a debug build at the bound); the largest function, `{}`, has {}. Fewer coordinates, or a G with fewer non-zero entries, make less code",
+                largest.quantity.spec().name,
+                largest.program.instrs.len()
+            )),
+            Some(span.clone()),
+        );
+    }
+    if options.scalar == Scalar::F32 {
+        if let Some(w) = d.walls.iter().find(|w| w.structured()) {
+            return refuse(
+                ErrorKind::Structure(format!(
+                    "f32 generation needs a closed-form P, and wall `{}` is structured: set `projector = \"symbolic\"` under [model]",
+                    w.name
                 )),
-                Some(d.model.kinetic_energy.span.clone()),
+                None,
             );
-            return cx.conclude(Err(e));
+        }
+        let too_large =
+            functions().find(|(f, _)| f.program.consts.iter().any(|c| c.abs() > f32::MAX as f64));
+        if let Some((f, span)) = too_large {
+            return refuse(
+                ErrorKind::Limit(format!(
+                    "a constant of `{}` exceeds f32's range (about 3.4e38): generate f64 code",
+                    f.quantity.spec().name
+                )),
+                Some(span.clone()),
+            );
         }
     }
-    Ok(emit::file(&d, options))
+    Ok(())
 }
 
 /// The formatted Rust source for the model in `path` with `f32` arithmetic
@@ -197,6 +232,10 @@ pub fn compile_dir(models_dir: &Path, out_dir: &Path) -> Result<Vec<Generated>, 
     for (model, generated) in here {
         match derive::derive(&model) {
             Ok(d) => {
+                if let Err(e) = emittable(&d, Options::default()) {
+                    errors.push(e);
+                    continue;
+                }
                 let rust_file = &generated.rust_file;
                 if let Err(e) = std::fs::write(rust_file, emit::file(&d, Options::default())) {
                     let mut cx = diag::Collector::new(&generated.model_file, "");
