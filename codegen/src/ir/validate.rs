@@ -10,7 +10,8 @@ use toml::Spanned;
 use super::expr::MAX_DEGREE;
 use super::file::{File, Names, Number, ParamDecl, WallDecl};
 use super::limits::{
-    self, MAX_DEFINITIONS, MAX_EXPANDED_DEPTH, MAX_EXPANDED_SIZE, MAX_NESTED_DIVISIONS, MAX_TERMS,
+    self, MAX_DEFINITIONS, MAX_EXPANDED_DEPTH, MAX_EXPANDED_SIZE, MAX_NESTED_DIVISIONS,
+    MAX_PARAMETERS, MAX_TERMS,
 };
 use super::number::rational;
 use super::order::{dependency_order, reaches};
@@ -127,6 +128,15 @@ impl Validator<'_> {
     ) -> (Vec<Param>, Vec<(Spanned<String>, Expr)>) {
         let mut out = Vec::new();
         let mut derived = Vec::new();
+        if decls.len() > MAX_PARAMETERS {
+            self.cx.error(
+                ErrorKind::Limit(format!(
+                    "{} parameters; the limit is {MAX_PARAMETERS} (every program of the derivation takes them all)",
+                    decls.len()
+                )),
+                decls.get_index(MAX_PARAMETERS).map(|(n, _)| n.span()),
+            );
+        }
         for (name, decl) in decls {
             self.declare(name, "parameter");
             let (value, doc) = match decl.get_ref() {
