@@ -6,10 +6,10 @@
 
 use symbolica::prelude::*;
 
-use super::checks;
 use super::lower::Lowering;
 use super::symbols::Symbols;
 use super::{Field, Rat, is_zero, rows_matrix};
+use super::{budget, checks};
 use crate::diag::{Collector, ErrorKind, Reported};
 use crate::ir::{Kind, ProjectorMode, Wall};
 
@@ -302,10 +302,26 @@ pub fn exact(
         .iter()
         .map(|r| r.iter().map(|x| low.reduce(x)).collect())
         .collect();
+    // An exact G⁻¹ is attempted only within its budget: asked for, a
+    // closed form past it is an error; chosen, it gives way to structured
+    // evaluation.
+    let terms = || budget::determinant_terms(&g);
     let structured = match m.projector {
+        ProjectorMode::Symbolic if terms() > budget::MAX_DETERMINANT_TERMS => {
+            return Err(cx.error(
+                ErrorKind::Limit(format!(
+                    "`projector = \"symbolic\"` needs G⁻¹ exactly, and det G may have up to {:.0} terms (the product of its entries' term counts over permutations), more than the {} a closed-form P is derived for; without it, P v is solved at run time from G and B (structured evaluation)",
+                    terms(),
+                    budget::MAX_DETERMINANT_TERMS
+                )),
+                Some(m.kinetic_energy.span.clone()),
+            ));
+        }
         ProjectorMode::Symbolic => false,
         ProjectorMode::Structured => true,
-        ProjectorMode::Auto => off_diagonal_entries(&g) > 2 * n,
+        ProjectorMode::Auto => {
+            off_diagonal_entries(&g) > 2 * n || terms() > budget::MAX_DETERMINANT_TERMS
+        }
     };
     Ok(Exact {
         g,

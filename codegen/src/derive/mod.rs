@@ -17,6 +17,7 @@
 //! The result is plain data ([`Derivation`]); [`inspect`] has symbolic
 //! helpers for front ends and tests.
 
+mod budget;
 mod build;
 mod checks;
 mod coefficients;

@@ -1,0 +1,196 @@
+//! What an exact G⁻¹ would cost, estimated before it is attempted: the
+//! number of terms of det G, bounded by the permanent of the matrix of
+//! its entries' term counts (each of det G's n! products has at most as
+//! many terms as the product of its factors' counts). Blocks of G that no
+//! non-zero entry couples are inverted apart, so the estimate is the
+//! largest block's; a block of numbers alone costs nothing.
+
+use symbolica::prelude::*;
+
+use super::is_zero;
+
+/// The largest estimate of det G's terms that a closed-form P is derived
+/// for. chain_4_symbolic's G (4×4, entries of 2 to 6 terms) estimates
+/// 1608 and derives in 20 s; chain_3's 74 in 0.6 s; chain_5's 53 992 ran
+/// past 120 s and 4.9 GB (`dalembert derive`, 2026-12-05): the time grows
+/// somewhat faster than the estimate.
+pub const MAX_DETERMINANT_TERMS: f64 = 5000.0;
+
+/// Blocks larger than this are bounded by the product of their rows' sums
+/// (an upper bound on the permanent) instead of computed exactly (Ryser's
+/// formula, 2ⁿ·n² operations).
+const EXACT_UP_TO: usize = 16;
+
+/// The estimate for G, entry by entry.
+pub fn determinant_terms(g: &[Vec<Atom>]) -> f64 {
+    let counts: Vec<Vec<Option<u64>>> = g
+        .iter()
+        .map(|row| row.iter().map(term_count).collect())
+        .collect();
+    blocks(&counts)
+        .iter()
+        .filter(|block| {
+            !block
+                .iter()
+                .all(|&i| block.iter().all(|&j| counts[i][j].is_none_or(|c| c == 0)))
+        })
+        .map(|block| {
+            let sub: Vec<Vec<f64>> = block
+                .iter()
+                .map(|&i| {
+                    block
+                        .iter()
+                        .map(|&j| counts[i][j].unwrap_or(1) as f64)
+                        .collect()
+                })
+                .collect();
+            permanent_bound(&sub)
+        })
+        .fold(0.0, f64::max)
+}
+
+/// The number of terms of an entry as a sum (0 for zero); `None` for a
+/// plain number, which adds no symbol to a product.
+fn term_count(a: &Atom) -> Option<u64> {
+    match a.as_view() {
+        AtomView::Num(_) if is_zero(a) => Some(0),
+        AtomView::Num(_) => None,
+        AtomView::Add(s) => Some(s.iter().count() as u64),
+        _ if is_zero(a) => Some(0),
+        _ => Some(1),
+    }
+}
+
+/// The sets of indices that non-zero entries connect, each sorted.
+fn blocks(counts: &[Vec<Option<u64>>]) -> Vec<Vec<usize>> {
+    let n = counts.len();
+    let mut block: Vec<usize> = (0..n).collect();
+    fn root(block: &mut [usize], mut i: usize) -> usize {
+        while block[i] != i {
+            block[i] = block[block[i]];
+            i = block[i];
+        }
+        i
+    }
+    for (i, row) in counts.iter().enumerate() {
+        for (j, &entry) in row.iter().enumerate().take(i) {
+            if entry != Some(0) || counts[j][i] != Some(0) {
+                let (a, b) = (root(&mut block, i), root(&mut block, j));
+                block[a] = b;
+            }
+        }
+    }
+    let mut out: Vec<Vec<usize>> = Vec::new();
+    let mut index = vec![usize::MAX; n];
+    for i in 0..n {
+        let r = root(&mut block, i);
+        if index[r] == usize::MAX {
+            index[r] = out.len();
+            out.push(Vec::new());
+        }
+        out[index[r]].push(i);
+    }
+    out
+}
+
+/// The permanent of a square matrix of non-negative numbers, exactly up
+/// to [`EXACT_UP_TO`] rows (Ryser), else the product of its row sums.
+fn permanent_bound(a: &[Vec<f64>]) -> f64 {
+    let n = a.len();
+    if n > EXACT_UP_TO {
+        return a.iter().map(|row| row.iter().sum::<f64>()).product();
+    }
+    let mut total = 0.0;
+    for subset in 1u32..(1 << n) {
+        let product: f64 = a
+            .iter()
+            .map(|row| {
+                (0..n)
+                    .filter(|j| subset >> j & 1 == 1)
+                    .map(|j| row[j])
+                    .sum::<f64>()
+            })
+            .product();
+        let sign = if (n as u32 - subset.count_ones()).is_multiple_of(2) {
+            1.0
+        } else {
+            -1.0
+        };
+        total += sign * product;
+    }
+    total
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The permanent by its definition: the sum over permutations.
+    fn by_permutations(a: &[Vec<f64>]) -> f64 {
+        fn go(a: &[Vec<f64>], row: usize, used: &mut Vec<bool>) -> f64 {
+            if row == a.len() {
+                return 1.0;
+            }
+            let mut sum = 0.0;
+            for j in 0..a.len() {
+                if !used[j] {
+                    used[j] = true;
+                    sum += a[row][j] * go(a, row + 1, used);
+                    used[j] = false;
+                }
+            }
+            sum
+        }
+        go(a, 0, &mut vec![false; a.len()])
+    }
+
+    /// The term counts of the n-link chain's G: n − max(i, j) + 1 masses
+    /// on the diagonal, twice that (a cosine of a difference, expanded)
+    /// off it.
+    fn chain(n: usize) -> Vec<Vec<f64>> {
+        (0..n)
+            .map(|i| {
+                (0..n)
+                    .map(|j| {
+                        let masses = (n - i.max(j)) as f64;
+                        if i == j { masses } else { 2.0 * masses }
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn ryser_is_the_permanent() {
+        for n in 1..=7 {
+            let a = chain(n);
+            assert_eq!(permanent_bound(&a), by_permutations(&a), "n = {n}");
+        }
+        let a: Vec<Vec<f64>> = (0..6)
+            .map(|i| (0..6).map(|j| ((3 * i + 5 * j) % 7) as f64).collect())
+            .collect();
+        assert_eq!(permanent_bound(&a), by_permutations(&a));
+        assert_eq!(permanent_bound(&chain(4)), 1608.0);
+        assert_eq!(permanent_bound(&chain(5)), 53992.0);
+    }
+
+    #[test]
+    fn large_blocks_are_bounded_by_row_sums() {
+        let a = vec![vec![1.0; EXACT_UP_TO + 1]; EXACT_UP_TO + 1];
+        let n = (EXACT_UP_TO + 1) as f64;
+        let bound = n.powi(EXACT_UP_TO as i32 + 1);
+        assert!((permanent_bound(&a) / bound - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn uncoupled_blocks_are_apart() {
+        let z = Some(0);
+        let counts = vec![
+            vec![Some(2), z, Some(3), z],
+            vec![z, None, z, z],
+            vec![Some(3), z, Some(1), z],
+            vec![z, z, z, Some(4)],
+        ];
+        assert_eq!(blocks(&counts), vec![vec![0, 2], vec![1], vec![3]]);
+    }
+}
