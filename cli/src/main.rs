@@ -18,7 +18,7 @@ use dalembert::runtime::Walls;
 use dalembert_codegen::derive::Projection;
 use dalembert_codegen::derive::inspect as symbolic;
 use dalembert_codegen::quantity::Quantity;
-use dalembert_codegen::reference::{Comparison, Reference};
+use dalembert_codegen::reference::{Comparison, Difference, Reference};
 use dalembert_codegen::{Derivation, ModelErrors};
 
 const MODELS_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../models");
@@ -443,11 +443,14 @@ fn report(d: &Derivation, r: &Reference, c: &Comparison, who: &str) -> bool {
             x.derived
         );
     }
+    // Where a differing entry is written, for the reader to go and look.
+    let at = |x: &Difference| x.at.as_ref().map(|a| format!(" ({a})")).unwrap_or_default();
     for x in &other {
         println!(
-            "  entry ({},{}) DIFFERS: reference {}, derived {}",
+            "  entry ({},{}) DIFFERS{}: reference {}, derived {}",
             x.row + 1,
             x.col + 1,
+            at(x),
             x.reference,
             x.derived
         );
@@ -458,8 +461,9 @@ fn report(d: &Derivation, r: &Reference, c: &Comparison, who: &str) -> bool {
         }
         for x in c.collision.iter().filter(|x| x.numerically_equal.is_none()) {
             println!(
-                "  collision component {} DIFFERS: reference {}, derived {}",
+                "  collision component {} DIFFERS{}: reference {}, derived {}",
                 x.row + 1,
+                at(x),
                 x.reference,
                 x.derived
             );

@@ -124,9 +124,47 @@ surface = "cos(a)*x + sin(a)*y"
     let (code, out) = check_file(&model, "wrong", &reference("sin(2*a)"));
     assert_eq!(code, Some(1), "{out}");
     assert!(
-        out.contains("entry (1,2) DIFFERS") && out.contains("DISAGREES"),
+        out.contains("entry (1,2) DIFFERS (")
+            && out.contains("wrong.toml:4:35): reference")
+            && out.contains("DISAGREES"),
         "{out}"
     );
+}
+
+/// Mistakes in a reference are reported at their place in its file, as a
+/// model file's are: an entry that does not parse, one that is undefined
+/// as written, a row of the wrong length, and a file that is not TOML.
+/// Before, they named only "P entry (2, 2)", or nothing.
+#[test]
+fn reference_mistakes_are_located() {
+    let head = "model = \"pendulum_wall\"\nwall = \"wall\"\nsource = \"a test\"\n";
+    let cases = [
+        (
+            "unclosed",
+            "projector = [\n  [\"1\", \"0\"],\n  [\"0\", \"(1\"],\n]\n",
+            "unclosed.toml:6:9: the reference's P entry (2, 2), `(1`",
+        ),
+        (
+            "zero_power",
+            "projector = [[\"0^0\", \"0\"], [\"0\", \"1\"]]\n",
+            "zero_power.toml:4:15: the reference's P entry (1, 1), `0^0`: `0^0` is 0 to the power 0",
+        ),
+        (
+            "short_row",
+            "projector = [\n  [\"1\", \"0\"],\n  [\"0\"],\n]\n",
+            "short_row.toml:6:4: the reference P must be 2×2: its row 2 has 1 entries",
+        ),
+        (
+            "not_toml",
+            "projector = [[\"1\", \"0\"], [\"0\", \"1\"]\n",
+            "not_toml.toml:5:1:",
+        ),
+    ];
+    for (name, body, expected) in cases {
+        let (code, out) = check("pendulum_wall", name, &format!("{head}{body}"));
+        assert_eq!(code, Some(2), "{name}: {out}");
+        assert!(out.contains(expected), "{name}: {out}");
+    }
 }
 
 /// A reference entry that is undefined as written (0^0, which once

@@ -8,10 +8,12 @@
 //! are compared after that substitution. Entries are compared exactly, as
 //! rational functions.
 
+use std::ops::Range;
 use std::path::Path;
 
 use indexmap::IndexMap;
 use serde::Deserialize;
+use toml::Spanned;
 
 use crate::derive::inspect as symbolic;
 use crate::derive::{Derivation, Projection};
@@ -37,6 +39,37 @@ pub struct Reference {
     /// Velocities to eliminate before comparing collision laws.
     #[serde(default)]
     pub admissible: IndexMap<String, String>,
+    /// Where each expression is in the file, when read by
+    /// [`Reference::load`] (messages name `file:line:col`).
+    #[serde(skip)]
+    places: Places,
+}
+
+/// The file a reference was read from and where its expressions are in it.
+#[derive(Debug, Clone, Default)]
+struct Places {
+    file: String,
+    text: String,
+    prefactor: Option<Range<usize>>,
+    projector: Vec<Vec<Range<usize>>>,
+    collision: Vec<Range<usize>>,
+    admissible: Vec<Range<usize>>,
+}
+
+/// A reference file as written, each expression with its place.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Located {
+    model: String,
+    wall: String,
+    #[serde(default)]
+    source: String,
+    prefactor: Option<Spanned<String>>,
+    projector: Vec<Vec<Spanned<String>>>,
+    #[serde(default)]
+    collision: Vec<Spanned<String>>,
+    #[serde(default)]
+    admissible: IndexMap<String, Spanned<String>>,
 }
 
 /// One entry where derivation and reference differ.
@@ -50,6 +83,8 @@ pub struct Difference {
     pub reference: String,
     /// The derived entry.
     pub derived: String,
+    /// Where the reference's entry is (`file:line:col`), if known.
+    pub at: Option<String>,
     /// Where the two are not shown equal symbolically but agree at random
     /// points (within [`NUMERIC_AGREEMENT`]): how many points. Evidence,
     /// not proof (an identity the symbolic reduction does not know, such
@@ -81,7 +116,51 @@ impl Reference {
     /// Reads a reference file.
     pub fn load(path: &Path) -> Result<Self, String> {
         let text = crate::ir::read_source(path).map_err(|e| e.render())?;
-        toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))
+        let file = path.display().to_string();
+        let r: Located = toml::from_str(&text).map_err(|e| match e.span() {
+            Some(span) => {
+                let (line, col) = crate::diag::line_col(&text, span.start);
+                format!("{file}:{line}:{col}: {}", e.message())
+            }
+            None => format!("{file}: {}", e.message()),
+        })?;
+        let plain = |e: &Spanned<String>| e.get_ref().clone();
+        Ok(Reference {
+            model: r.model,
+            wall: r.wall,
+            source: r.source,
+            prefactor: r.prefactor.as_ref().map(plain),
+            projector: (r.projector.iter())
+                .map(|row| row.iter().map(plain).collect())
+                .collect(),
+            collision: r.collision.iter().map(plain).collect(),
+            admissible: (r.admissible.iter())
+                .map(|(k, e)| (k.clone(), plain(e)))
+                .collect(),
+            places: Places {
+                prefactor: r.prefactor.as_ref().map(Spanned::span),
+                projector: (r.projector.iter())
+                    .map(|row| row.iter().map(Spanned::span).collect())
+                    .collect(),
+                collision: r.collision.iter().map(Spanned::span).collect(),
+                admissible: r.admissible.values().map(Spanned::span).collect(),
+                file,
+                text,
+            },
+        })
+    }
+
+    /// `file:line:col` of the expression at `span` in the file read, if
+    /// it was read from one.
+    fn at(&self, span: Option<&Range<usize>>) -> Option<String> {
+        let span = span?;
+        let (line, col) = crate::diag::line_col(&self.places.text, span.start);
+        Some(format!("{}:{line}:{col}", self.places.file))
+    }
+
+    /// Where P's entry (i, j) is, if known.
+    fn entry_at(&self, i: usize, j: usize) -> Option<String> {
+        self.at(self.places.projector.get(i).and_then(|row| row.get(j)))
     }
 
     /// The reference's entry (i, j) of P with the prefactor applied.
@@ -92,22 +171,32 @@ impl Reference {
         }
     }
 
-    /// Every expression of the reference, with where it is (1-based).
-    fn expressions(&self) -> Vec<(String, &str)> {
+    /// Every expression of the reference, with what it is (1-based) and,
+    /// if known, where: `file:line:col: ` or nothing.
+    fn expressions(&self) -> Vec<(String, String, &str)> {
+        let prefix = |at: Option<String>| at.map(|a| format!("{a}: ")).unwrap_or_default();
         let mut out = Vec::new();
         if let Some(f) = &self.prefactor {
-            out.push(("prefactor".to_string(), f.as_str()));
+            let at = self.at(self.places.prefactor.as_ref());
+            out.push(("prefactor".to_string(), prefix(at), f.as_str()));
         }
         for (i, row) in self.projector.iter().enumerate() {
             for (j, e) in row.iter().enumerate() {
-                out.push((format!("P entry ({}, {})", i + 1, j + 1), e.as_str()));
+                let what = format!("P entry ({}, {})", i + 1, j + 1);
+                out.push((what, prefix(self.entry_at(i, j)), e.as_str()));
             }
         }
         for (i, e) in self.collision.iter().enumerate() {
-            out.push((format!("collision component {}", i + 1), e.as_str()));
+            let at = self.at(self.places.collision.get(i));
+            out.push((
+                format!("collision component {}", i + 1),
+                prefix(at),
+                e.as_str(),
+            ));
         }
-        for (name, e) in &self.admissible {
-            out.push((format!("[admissible] `{name}`"), e.as_str()));
+        for (k, (name, e)) in self.admissible.iter().enumerate() {
+            let at = self.at(self.places.admissible.get(k));
+            out.push((format!("[admissible] `{name}`"), prefix(at), e.as_str()));
         }
         out
     }
@@ -125,9 +214,15 @@ impl Reference {
                 || m.coordinates.iter().any(|n| n == name)
                 || m.velocities.iter().any(|n| n == name)
         };
-        for (place, text) in self.expressions() {
+        for (place, at, text) in self.expressions() {
             let node = crate::ir::expr::parse(text)
-                .map_err(|e| format!("the reference's {place}, `{text}`: {}", e.message))?;
+                .map_err(|e| format!("{at}the reference's {place}, `{text}`: {}", e.message))?;
+            if let Some((span, what)) = node.constant_problem() {
+                let part = text.get(span).unwrap_or_default();
+                return Err(format!(
+                    "{at}the reference's {place}, `{text}`: `{part}` is {what}"
+                ));
+            }
             let mut unknown = None;
             node.visit_names(&mut |name, _| {
                 if unknown.is_none() && !known(name) {
@@ -160,7 +255,7 @@ impl Reference {
                 .flatten()
                 .collect();
                 return Err(format!(
-                    "the reference's {place}, `{text}`, names `{name}`, which `{}` does not declare ({})",
+                    "{at}the reference's {place}, `{text}`, names `{name}`, which `{}` does not declare ({})",
                     m.name,
                     declared.join("; ")
                 ));
@@ -217,8 +312,12 @@ impl Reference {
             .enumerate()
             .find(|(_, r)| r.len() != n)
         {
+            let at = self
+                .entry_at(i, 0)
+                .map(|a| format!("{a}: "))
+                .unwrap_or_default();
             return Err(format!(
-                "the reference P must be {n}×{n}: its row {} has {} entries",
+                "{at}the reference P must be {n}×{n}: its row {} has {} entries",
                 i + 1,
                 row.len()
             ));
@@ -257,6 +356,7 @@ impl Reference {
                     projector.push(Difference {
                         row: i,
                         col: j,
+                        at: self.entry_at(i, j),
                         numerically_equal: numerically(&reference, &derived_p[i][j])?,
                         reference,
                         derived: derived_p[i][j].clone(),
@@ -278,6 +378,7 @@ impl Reference {
                     collision.push(Difference {
                         row: i,
                         col: 0,
+                        at: self.at(self.places.collision.get(i)),
                         numerically_equal: numerically(&r_sub, &c_sub)?,
                         reference: r.clone(),
                         derived: c.clone(),
