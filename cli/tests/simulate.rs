@@ -30,6 +30,12 @@ fn writes_the_trajectory_and_the_plot() {
         dalembert(&["simulate", "pendulum_wall", "--t-end", "3", "--out", out]);
     assert!(ok, "{stdout}\n{stderr}");
     assert!(stdout.contains("collisions"), "{stdout}");
+    // The output's bound is said before the run.
+    assert!(
+        stdout.starts_with("pendulum_wall: writing ")
+            && stdout.contains("a row every 0.0015 to t = 3 (2001 rows) and two per collision, at most 10000000 rows"),
+        "{stdout}"
+    );
     let csv = std::fs::read_to_string(dir.join("pendulum_wall.csv")).unwrap();
     let mut lines = csv.lines();
     assert_eq!(

@@ -307,6 +307,16 @@ fn run<M: Surfaces<N>, const N: usize>(
         residual: [start_residual.velocity, start_residual.position],
         event: None,
     })?;
+    // The output's bound, before a run that may be long.
+    println!(
+        "{}: writing {}: a row every {every} to t = {} ({} rows) and two per collision, at most {MAX_ROWS} rows",
+        model.name(),
+        csv.display(),
+        args.t_end,
+        // Rows at t = 0 and k·every up to t_end (a quotient a rounding
+        // above a whole number is that number).
+        (args.t_end / every * (1.0 - 1e-12)).ceil() as u64 + 1
+    );
     let clock = Instant::now();
     let dense = matches!(args.integrator, Method::Taylor);
     let failure = integrate(&mut sim, &model, (args.t_end, every, dense), &mut out)?;
