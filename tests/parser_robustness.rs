@@ -312,6 +312,22 @@ fn mutated_model_files_never_panic_or_hang() {
     );
 }
 
+/// The long run of the reader and validator alone (no symbolic engine),
+/// outside the default test command: `DALEMBERT_FUZZ_CASES=100000 cargo
+/// test --release --test parser_robustness -- --ignored --nocapture
+/// validator_long` (up to five mutations of every corpus file, each case
+/// within 2 s).
+#[test]
+#[ignore = "long: run on purpose (see its doc)"]
+fn mutated_model_files_validator_long() {
+    let cases = std::env::var("DALEMBERT_FUZZ_CASES")
+        .ok()
+        .and_then(|c| c.parse().ok())
+        .unwrap_or(100_000);
+    let o = mutate(&corpus(), cases, 5, false, Duration::from_secs(2));
+    eprintln!("{cases} cases: {o:?}");
+}
+
 /// The good model files (one or two mutations of them still validate
 /// often enough to reach the derivation).
 fn good() -> Vec<String> {
