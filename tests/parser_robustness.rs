@@ -312,6 +312,14 @@ fn mutated_model_files_never_panic_or_hang() {
     );
 }
 
+/// Cases of a long run: `DALEMBERT_FUZZ_CASES`, 10⁵ if unset.
+fn long_run_cases() -> u32 {
+    std::env::var("DALEMBERT_FUZZ_CASES")
+        .ok()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(100_000)
+}
+
 /// The long run of the reader and validator alone (no symbolic engine),
 /// outside the default test command: `DALEMBERT_FUZZ_CASES=100000 cargo
 /// test --release --test parser_robustness -- --ignored --nocapture
@@ -320,10 +328,7 @@ fn mutated_model_files_never_panic_or_hang() {
 #[test]
 #[ignore = "long: run on purpose (see its doc)"]
 fn mutated_model_files_validator_long() {
-    let cases = std::env::var("DALEMBERT_FUZZ_CASES")
-        .ok()
-        .and_then(|c| c.parse().ok())
-        .unwrap_or(100_000);
+    let cases = long_run_cases();
     let o = mutate(&corpus(), cases, 5, false, Duration::from_secs(2));
     eprintln!("{cases} cases: {o:?}");
 }
@@ -367,16 +372,13 @@ fn mutated_models_through_derivation() {
 
 /// The long run, outside the default test command:
 /// `DALEMBERT_FUZZ_CASES=100000 RUST_TEST_THREADS=1 cargo test --release
-/// --test parser_robustness -- --ignored --nocapture` (every file of the
+/// --test parser_robustness -- --ignored --nocapture through_derivation_long` (every file of the
 /// good model file but chain_4_symbolic, one or two mutations each, each
 /// case within 60 s).
 #[test]
 #[ignore = "long: run on purpose (see its doc)"]
 fn mutated_models_through_derivation_long() {
-    let cases = std::env::var("DALEMBERT_FUZZ_CASES")
-        .ok()
-        .and_then(|n| n.parse().ok())
-        .unwrap_or(100_000);
+    let cases = long_run_cases();
     // chain_4_symbolic alone takes seconds per derivation (its closed-form P
     // is why `auto` chooses structured there): left to the default sample's
     // rule, the other files all take part.

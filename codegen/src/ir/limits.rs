@@ -100,6 +100,27 @@ pub(super) fn count(n: u64) -> String {
 /// 250 ran past a minute.
 pub(super) const MAX_VARIABLES: usize = 100;
 
+/// At most `limit` declarations of one kind (`count` of them, `what` they
+/// are, and why there is a limit, if the message should say): false, with
+/// an error at `first_past` (the first declaration past it), if there are
+/// more.
+pub(super) fn declarations(
+    cx: &mut Collector,
+    (count, limit): (usize, usize),
+    what: &str,
+    why: &str,
+    first_past: Option<Range<usize>>,
+) -> bool {
+    if count <= limit {
+        return true;
+    }
+    cx.error(
+        ErrorKind::Limit(format!("{count} {what}; the limit is {limit}{why}")),
+        first_past,
+    );
+    false
+}
+
 /// At most [`MAX_VARIABLES`] coordinates or velocities.
 pub(super) fn variable_count(cx: &mut Collector, n: usize, span: Range<usize>) {
     if n > MAX_VARIABLES {

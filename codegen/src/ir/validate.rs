@@ -128,15 +128,13 @@ impl Validator<'_> {
     ) -> (Vec<Param>, Vec<(Spanned<String>, Expr)>) {
         let mut out = Vec::new();
         let mut derived = Vec::new();
-        if decls.len() > MAX_PARAMETERS {
-            self.cx.error(
-                ErrorKind::Limit(format!(
-                    "{} parameters; the limit is {MAX_PARAMETERS} (every program of the derivation takes them all)",
-                    decls.len()
-                )),
-                decls.get_index(MAX_PARAMETERS).map(|(n, _)| n.span()),
-            );
-        }
+        limits::declarations(
+            self.cx,
+            (decls.len(), MAX_PARAMETERS),
+            "parameters",
+            " (every program of the derivation takes them all)",
+            decls.get_index(MAX_PARAMETERS).map(|(n, _)| n.span()),
+        );
         for (name, decl) in decls {
             self.declare(name, "parameter");
             let (value, doc) = match decl.get_ref() {
@@ -330,14 +328,14 @@ impl Validator<'_> {
     /// are reported, and so is a definition that would expand past the
     /// limits once the ones it uses are substituted.
     fn definitions(&mut self, decls: Vec<(Spanned<String>, Expr)>) -> Vec<(String, Expr)> {
-        if decls.len() > MAX_DEFINITIONS {
-            self.cx.error(
-                ErrorKind::Limit(format!(
-                    "{} definitions; the limit is {MAX_DEFINITIONS}",
-                    decls.len()
-                )),
-                decls.get(MAX_DEFINITIONS).map(|(n, _)| n.span()),
-            );
+        let first_past = decls.get(MAX_DEFINITIONS).map(|(n, _)| n.span());
+        if !limits::declarations(
+            self.cx,
+            (decls.len(), MAX_DEFINITIONS),
+            "definitions",
+            "",
+            first_past,
+        ) {
             return Vec::new();
         }
         let (names, exprs): (Vec<Spanned<String>>, Vec<Expr>) = decls.into_iter().unzip();
