@@ -6,7 +6,9 @@
 
 use super::integrator::{Method, RungeKutta, Trial};
 use super::phase::Phase;
-use super::thresholds::{ROOT_ITERATIONS, SHORTEST_AIM_ULPS};
+use super::thresholds::{
+    RESOLVE_DEPTH, RESOLVED_DEFECT, RESOLVED_ROUNDING_ULPS, ROOT_ITERATIONS, SHORTEST_AIM_ULPS,
+};
 use super::{SimError, Simulator};
 use crate::taylor::Series;
 use crate::{Surfaces, libm, linalg};
@@ -117,20 +119,28 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         best
     }
 
-    /// The first wall crossed on the step of length `h` from t0 whose motion
-    /// is `path` (index into the model's `walls()`, time on the path), if
-    /// any.
-    pub(super) fn first_crossing(
+    /// What the step of length `h` from t0 whose motion is `path` meets
+    /// first: the earliest wall crossed on it, or a wall whose f its
+    /// samples do not resolve before that.
+    pub(super) fn scan(
         &self,
         path: &impl Path<N>,
         t0: f64,
         h: f64,
-    ) -> Result<Option<Crossing>, SimError<M::Wall>> {
+    ) -> Result<Scan, SimError<M::Wall>> {
         let mut best: Option<Crossing> = None;
         let mut second: Option<Crossing> = None;
+        let mut unresolved: Option<Unresolved> = None;
         for k in 0..self.model.walls().len() {
-            let Some(theta) = self.wall_crossing(k, path, t0, h)? else {
-                continue;
+            let theta = match self.wall_crossing(k, path, t0, h)? {
+                None => continue,
+                Some(Met::Crossing(theta)) => theta,
+                Some(Met::Unresolved(u)) => {
+                    if unresolved.is_none_or(|v| u.from < v.from) {
+                        unresolved = Some(u);
+                    }
+                    continue;
+                }
             };
             let now = Crossing {
                 wall: k,
@@ -149,6 +159,11 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
                 }
             }
         }
+        if let Some(u) = unresolved
+            && best.is_none_or(|b| b.theta >= u.from)
+        {
+            return Ok(Scan::Unresolved(u));
+        }
         if let (Some(a), Some(b)) = (best, second)
             && b.t - a.t <= self.settings.simultaneity_window(a.t, h)
         {
@@ -158,70 +173,208 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
                 t: a.t,
             });
         }
-        Ok(best)
+        Ok(best.map_or(Scan::Clear, Scan::Crossing))
     }
 
-    /// Where on the step (θ ∈ [0, 1]) wall `k` is first met, if it is.
+    /// Where on the step (θ ∈ [0, 1]) wall `k` is first met, if it is, or
+    /// where its f stops being resolved.
     ///
-    /// f and its rate df·q̇ are sampled along the path. Met means f
-    /// goes from > 0 to ≤ 0 between samples; a dip below zero between two
-    /// positive samples is caught by the rate changing sign (its bottom is
-    /// located first). A wall just collided with starts at f ≈ 0 moving
-    /// away: it is met again only after f has been positive, which is also
-    /// checked between samples through the top of the excursion.
+    /// f and its rate df·q̇ are sampled along the path, at the step's
+    /// settings' points, and between two of them wherever the rates do not
+    /// explain f's change ([`explained`]): a pole of f (a tangent's, a
+    /// quotient's) or a narrow excursion jumped between two samples shows
+    /// as such a change. The interval is halved until they do, at most
+    /// [`RESOLVE_DEPTH`] times; past that the step is too long for this
+    /// wall, and the caller shortens it ([`Met::Unresolved`]).
+    ///
+    /// Met means f goes from > 0 to ≤ 0 between samples; a dip below zero
+    /// between two positive samples is caught by the rate changing sign
+    /// (its bottom is located first). A wall just collided with starts at
+    /// f ≈ 0 moving away: it is met again only after f has been positive,
+    /// which is also checked between samples through the top of the
+    /// excursion.
     fn wall_crossing(
         &self,
         k: usize,
         path: &impl Path<N>,
         t0: f64,
         h: f64,
-    ) -> Result<Option<f64>, SimError<M::Wall>> {
+    ) -> Result<Option<Met>, SimError<M::Wall>> {
         let on = OnStep {
             model: self.model,
             wall: self.model.walls()[k],
             path,
         };
-        let (f, rate) = (|theta| on.f(theta), |theta| on.rate(theta));
         let n = self.settings.samples + 1;
-        let mut prev = on.sample(0.0);
-        let mut leaving = self.departing & (1 << k) != 0 && prev.f <= 0.0 && prev.rate > 0.0;
-        if !leaving && prev.f <= 0.0 {
+        let first = on.sample(0.0);
+        let leaving = self.departing & (1 << k) != 0 && first.f <= 0.0 && first.rate > 0.0;
+        if !leaving && first.f <= 0.0 {
             // At or beyond the wall at the step's start and not leaving it
             // (a projection can move q by rounding-sized amounts).
-            return Ok(Some(0.0));
+            return Ok(Some(Met::Crossing(0.0)));
         }
+        let mut walk = Walk {
+            prev: first,
+            leaving,
+        };
         for j in 1..=n {
             let now = on.sample(j as f64 / n as f64);
-            if leaving {
-                if now.f > 0.0 {
-                    leaving = false;
-                } else if now.rate <= 0.0 {
-                    // Turned back before a sample saw it off the wall: find
-                    // the top of the excursion.
-                    let top = illinois(&rate, (prev.theta, prev.rate), (now.theta, now.rate));
-                    let f_top = f(top);
-                    if f_top > 0.0 {
-                        return Ok(Some(illinois(&f, (top, f_top), (now.theta, now.f))));
-                    }
-                    return Err(SimError::Grazing {
-                        wall: on.wall,
-                        t: t0 + top * h,
-                        normal_velocity: rate(top),
-                    });
-                }
-            } else if now.f <= 0.0 {
-                return Ok(Some(illinois(&f, (prev.theta, prev.f), (now.theta, now.f))));
-            } else if prev.rate < 0.0 && now.rate > 0.0 {
-                // f stays positive at both samples but turns: check the
-                // bottom of the dip.
-                let falling = |theta: f64| -rate(theta);
-                let bottom = illinois(&falling, (prev.theta, -prev.rate), (now.theta, -now.rate));
-                let f_bottom = f(bottom);
-                if f_bottom <= 0.0 {
-                    return Ok(Some(illinois(&f, (prev.theta, prev.f), (bottom, f_bottom))));
+            if !explained(&walk.prev, &now, h) {
+                match walk.refined(&on, now, t0, h)? {
+                    Some(met) => return Ok(Some(met)),
+                    None => continue,
                 }
             }
-            prev = now;
+            if let Some(theta) = walk.to(&on, now, t0, h)? {
+                return Ok(Some(Met::Crossing(theta)));
+            }
+        }
+        Ok(None)
+    }
+}
+
+/// What a step meets first.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Scan {
+    /// No wall.
+    Clear,
+    /// A wall crossed.
+    Crossing(Crossing),
+    /// A wall whose f the step's samples do not resolve, before any
+    /// crossing: the step must be shorter ([`Unresolved::shorter`]).
+    Unresolved(Unresolved),
+}
+
+/// An interval of a step (θ from `from` to `to`) on which a wall's f is
+/// not resolved by samples [`RESOLVE_DEPTH`] halvings apart.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Unresolved {
+    pub from: f64,
+    pub to: f64,
+}
+
+impl Unresolved {
+    /// The length of a step from the same start that ends before the
+    /// interval, from the length `h` of the one that did not: up to its
+    /// beginning, or halfway into it where it begins at the start.
+    pub fn shorter(&self, h: f64) -> f64 {
+        if self.from > 0.0 {
+            self.from * h
+        } else {
+            0.5 * self.to * h
+        }
+    }
+}
+
+/// One wall's verdict on a step.
+enum Met {
+    Crossing(f64),
+    Unresolved(Unresolved),
+}
+
+/// Whether f's change between samples `a` and `b` of a step of length `h`
+/// is what their rates say: the trapezoid rule's defect, (f_b − f_a) −
+/// Δt (ḟ_a + ḟ_b)/2, at most [`RESOLVED_DEFECT`] of the change's size
+/// (|f_b − f_a| + Δt (|ḟ_a| + |ḟ_b|)/2), or within rounding of f. For f
+/// smooth on the interval the defect is Δt³ f⁽³⁾/12 and vanishes faster
+/// than the size as the interval is halved; across a pole (f falling to
+/// −∞ and back from +∞ while ḟ < 0 throughout) it is the size itself.
+/// A non-finite sample is never explained.
+#[inline(always)]
+fn explained(a: &Sample, b: &Sample, h: f64) -> bool {
+    let dt = (b.theta - a.theta) * h;
+    let change = b.f - a.f;
+    let defect = change - 0.5 * dt * (a.rate + b.rate);
+    let size = libm::fabs(change) + 0.5 * dt * (libm::fabs(a.rate) + libm::fabs(b.rate));
+    let rounding =
+        RESOLVED_ROUNDING_ULPS * f64::EPSILON * libm::fabs(a.f).max(libm::fabs(b.f)).max(1.0);
+    // (A NaN fails the comparison; an infinity makes the size infinite.)
+    size.is_finite() && libm::fabs(defect) <= RESOLVED_DEFECT * size + rounding
+}
+
+/// The walk along one wall's samples: the last one reached, and whether
+/// the motion is still leaving the wall it started on.
+struct Walk {
+    prev: Sample,
+    leaving: bool,
+}
+
+impl Walk {
+    /// Goes on to `end` through midpoints, where f's change from the last
+    /// sample to `end` is not explained by their rates; returns what is
+    /// met before `end` or there, or `None` to go on from `end`.
+    #[cold]
+    fn refined<M: Surfaces<N>, P: Path<N>, const N: usize>(
+        &mut self,
+        on: &OnStep<'_, M, P, N>,
+        end: Sample,
+        t0: f64,
+        h: f64,
+    ) -> Result<Option<Met>, SimError<M::Wall>> {
+        // The samples still to reach, the nearest last: `end` and the
+        // midpoints taken towards it.
+        let mut ahead = [end; RESOLVE_DEPTH + 1];
+        let mut pending = 1;
+        while pending > 0 {
+            let now = ahead[pending - 1];
+            if !explained(&self.prev, &now, h) {
+                if pending > RESOLVE_DEPTH {
+                    return Ok(Some(Met::Unresolved(Unresolved {
+                        from: self.prev.theta,
+                        to: now.theta,
+                    })));
+                }
+                ahead[pending] = on.sample(0.5 * (self.prev.theta + now.theta));
+                pending += 1;
+                continue;
+            }
+            pending -= 1;
+            if let Some(theta) = self.to(on, now, t0, h)? {
+                return Ok(Some(Met::Crossing(theta)));
+            }
+        }
+        Ok(None)
+    }
+
+    /// Goes on to the sample `now`: θ of the crossing between, if any.
+    #[inline(always)]
+    fn to<M: Surfaces<N>, P: Path<N>, const N: usize>(
+        &mut self,
+        on: &OnStep<'_, M, P, N>,
+        now: Sample,
+        t0: f64,
+        h: f64,
+    ) -> Result<Option<f64>, SimError<M::Wall>> {
+        let (f, rate) = (|theta| on.f(theta), |theta| on.rate(theta));
+        let prev = core::mem::replace(&mut self.prev, now);
+        if self.leaving {
+            if now.f > 0.0 {
+                self.leaving = false;
+            } else if now.rate <= 0.0 {
+                // Turned back before a sample saw it off the wall: find
+                // the top of the excursion.
+                let top = illinois(&rate, (prev.theta, prev.rate), (now.theta, now.rate));
+                let f_top = f(top);
+                if f_top > 0.0 {
+                    return Ok(Some(illinois(&f, (top, f_top), (now.theta, now.f))));
+                }
+                return Err(SimError::Grazing {
+                    wall: on.wall,
+                    t: t0 + top * h,
+                    normal_velocity: rate(top),
+                });
+            }
+        } else if now.f <= 0.0 {
+            return Ok(Some(illinois(&f, (prev.theta, prev.f), (now.theta, now.f))));
+        } else if prev.rate < 0.0 && now.rate > 0.0 {
+            // f stays positive at both samples but turns: check the
+            // bottom of the dip.
+            let falling = |theta: f64| -rate(theta);
+            let bottom = illinois(&falling, (prev.theta, -prev.rate), (now.theta, -now.rate));
+            let f_bottom = f(bottom);
+            if f_bottom <= 0.0 {
+                return Ok(Some(illinois(&f, (prev.theta, prev.f), (bottom, f_bottom))));
+            }
         }
         Ok(None)
     }
@@ -318,7 +471,43 @@ fn illinois(f: &impl Fn(f64) -> f64, a: (f64, f64), b: (f64, f64)) -> f64 {
 
 #[cfg(test)]
 mod tests {
-    use super::descending_root;
+    use super::{Sample, Unresolved, descending_root, explained};
+
+    fn at(theta: f64, f: f64, rate: f64) -> Sample {
+        Sample { theta, f, rate }
+    }
+
+    #[test]
+    fn changes_the_rates_explain() {
+        // f = 1 − t² over a step of length 1, sampled at θ = 0, 1/4 and 1:
+        // a polynomial of degree 2 is the trapezoid rule's exact case.
+        let f = |t: f64| at(t, 1.0 - t * t, -2.0 * t);
+        assert!(explained(&f(0.0), &f(0.25), 1.0));
+        assert!(explained(&f(0.25), &f(1.0), 1.0));
+        // A cubic over a short interval: defect Δt³/2 against a change of
+        // about 3Δt.
+        let c = |t: f64| at(t, 2.0 - t * t * t, -3.0 * t * t);
+        assert!(explained(&c(0.5), &c(0.6), 1.0));
+        // Across a pole: f falls at both samples but is higher at the
+        // second (tan(1 − r²) from inside the disk to beyond the ring).
+        assert!(!explained(&at(0.0, 0.2, -1.0), &at(0.5, 3.0, -40.0), 1.0));
+        // The same samples on a step 100 times shorter: the rates no
+        // longer say f must have fallen by much, but it rose.
+        assert!(!explained(&at(0.0, 0.2, -1.0), &at(0.5, 3.0, -40.0), 0.01));
+        // Motion along a wall: changes at rounding level are explained.
+        assert!(explained(&at(0.0, 0.5, 0.0), &at(1.0, 0.5 + 1e-16, 0.0), 1.0));
+        // A sample at a pole is never explained.
+        assert!(!explained(&at(0.0, 0.5, -1.0), &at(1.0, f64::INFINITY, -1.0), 1.0));
+        assert!(!explained(&at(0.0, 0.5, -1.0), &at(1.0, 0.4, f64::NAN), 1.0));
+    }
+
+    #[test]
+    fn shorter_steps_end_before_what_is_unresolved() {
+        let u = Unresolved { from: 0.25, to: 0.3 };
+        assert_eq!(u.shorter(2.0), 0.5);
+        let at_start = Unresolved { from: 0.0, to: 0.5 };
+        assert_eq!(at_start.shorter(2.0), 0.5);
+    }
 
     fn close(a: Option<f64>, b: f64) -> bool {
         a.is_some_and(|a| (a - b).abs() <= 1e-14 * b.abs())

@@ -77,7 +77,7 @@ use crate::Surfaces;
 use crate::dynamics::{accelerations, qdd};
 use crate::taylor::Series;
 use dense_output::LastStep;
-use events::RkStep;
+use events::{RkStep, Scan};
 use integrator::{Engine, Method, RungeKutta};
 use phase::{Phase, norm};
 use thresholds::{ADMISSIBLE, MAX_WALLS, ON_WALL, TAYLOR_REACH};
@@ -269,8 +269,27 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
         let t0 = self.state.t;
         let y0 = self.phase();
         let aim = self.aim(method, &y0);
-        let limit = aim.map_or(f64::INFINITY, |a| a.tau);
-        let (h, trial) = self.accepted_trial(method, &y0, t_end, limit)?;
+        let mut limit = aim.map_or(f64::INFINITY, |a| a.tau);
+        // A step along which a wall's f is not resolved is tried again,
+        // shorter (counted as rejected), from a proposal no longer than
+        // that: the next steps grow from there as the method allows.
+        let (h, trial, crossing) = loop {
+            let (h, trial) = self.accepted_trial(method, &y0, t_end, limit)?;
+            let path = RkStep {
+                y0: &y0,
+                trial: &trial,
+                h,
+            };
+            match self.scan(&path, t0, h)? {
+                Scan::Clear => break (h, trial, None),
+                Scan::Crossing(c) => break (h, trial, Some(c)),
+                Scan::Unresolved(u) => {
+                    limit = u.shorter(h);
+                    self.proposal = self.proposal.min(limit);
+                    self.stats.rejected += 1;
+                }
+            }
+        };
         let t1 = if t0 + h >= t_end { t_end } else { t0 + h };
         let reach = TAYLOR_REACH * h;
         let at_end = |wall: usize, t_hi: f64| Located {
@@ -280,12 +299,7 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
             f: Some(trial.f1),
             t_hi,
         };
-        let path = RkStep {
-            y0: &y0,
-            trial: &trial,
-            h,
-        };
-        let found = match self.first_crossing(&path, t0, h)? {
+        let found = match crossing {
             // Met at the very end of the step: polish from there.
             Some(c) if t1 - c.t <= reach => Some(at_end(c.wall, t1)),
             Some(c) => {

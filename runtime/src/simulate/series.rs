@@ -6,7 +6,7 @@
 //! the step's polynomial there, so a collision costs no further steps.
 
 use super::dense_output::LastStep;
-use super::events::SeriesStep;
+use super::events::{Scan, SeriesStep};
 use super::integrator::{Plan, Reach};
 use super::phase::Phase;
 use super::roots::first_root;
@@ -308,12 +308,24 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
                 series: &self.series,
                 tau: h,
             };
-            found = self.first_crossing(&path, t0, h)?.map(|c| Found {
-                wall: c.wall,
-                tau: c.theta * h,
-                scale: 1.0,
-            });
-            end = found.map_or(h, |c| c.tau);
+            (found, end) = match self.scan(&path, t0, h)? {
+                Scan::Clear => (None, h),
+                Scan::Crossing(c) => {
+                    let tau = c.theta * h;
+                    let wall = c.wall;
+                    (
+                        Some(Found {
+                            wall,
+                            tau,
+                            scale: 1.0,
+                        }),
+                        tau,
+                    )
+                }
+                // The polynomial holds the motion over the whole step: it
+                // ends before the interval instead.
+                Scan::Unresolved(u) => (None, u.shorter(h)),
+            };
             y = finite(self.series.state(end), t0)?;
         }
         let (q, v) = y;

@@ -57,6 +57,19 @@ pub const HOLONOMIC_DONE_ULPS: f64 = 4.0;
 /// failed projection.
 pub const HOLONOMIC_FAILED: f64 = 1e-10;
 
+/// Halvings at most of an interval between two of a step's samples of a
+/// wall's f whose change their rates do not explain (a pole, or an
+/// excursion narrower than the samples): past them the step is shortened.
+pub const RESOLVE_DEPTH: usize = 12;
+
+/// f's change between two samples is explained by their rates when the
+/// trapezoid rule's defect is at most this fraction of the change's size
+/// (see `events::explained`).
+pub const RESOLVED_DEFECT: f64 = 0.5;
+
+/// ... or within this many ulps of max(1, |f|) at the two samples.
+pub const RESOLVED_ROUNDING_ULPS: f64 = 64.0;
+
 /// Iterations at most of the Illinois root finder on the dense output.
 pub const ROOT_ITERATIONS: usize = 200;
 

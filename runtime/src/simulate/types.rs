@@ -26,7 +26,9 @@ pub struct Settings {
     /// 1e-12 wide is the same box as one 1 wide, seen faster.
     pub simultaneous: f64,
     /// Points per step (besides its ends) at which each wall's f is sampled
-    /// for sign changes on the dense output.
+    /// for sign changes on the dense output; more are taken between two
+    /// whose change of f their rates do not explain (a pole), and a step
+    /// that those do not resolve is shortened.
     pub samples: usize,
 }
 
