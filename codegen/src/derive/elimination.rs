@@ -50,7 +50,7 @@ impl Outputs {
 pub fn collision(
     sym: &Symbols,
     exact: &Exact,
-    compile: &Compiler,
+    compile: &Compiler<'_>,
     cx: &mut Collector,
     b: &[Vec<Atom>],
     span: &Range<usize>,
@@ -75,7 +75,7 @@ pub fn collision(
 pub fn motion(
     exact: &Exact,
     raw: &Raw,
-    compile: &Compiler,
+    compile: &Compiler<'_>,
     cx: &mut Collector,
     span: &Range<usize>,
 ) -> Result<Option<(Function, MotionSystem)>, Reported> {
@@ -109,7 +109,7 @@ pub fn motion(
 pub fn momentum(
     exact: &Exact,
     gradient: &[Atom],
-    compile: &Compiler,
+    compile: &Compiler<'_>,
     cx: &mut Collector,
     span: &Range<usize>,
 ) -> Result<Option<MotionSystem>, Reported> {

@@ -69,13 +69,17 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
     sym.sample = sample::configuration(&sym, &raw);
     let low = lower::Lowering::new(&sym, &raw);
     let exact = mechanics::exact(&sym, &low, &raw, cx)?;
+    let t_span = &model.kinetic_energy.span;
     let compile = Compiler {
         inputs: sym.inputs(),
         params: sym.params.len(),
         coords: sym.coords.len(),
         kind: model.kind,
+        blame: Blame {
+            sym: &sym,
+            raw: &raw,
+        },
     };
-    let t_span = &model.kinetic_energy.span;
     let g_flat: Vec<Atom> = exact.g.iter().flatten().cloned().collect();
     let mass_matrix = compile.program(cx, Quantity::MassMatrix, &g_flat, 0, t_span)?;
     checks::positive_definite(&sym, &raw, cx, &mass_matrix.program);
@@ -177,16 +181,58 @@ fn initial_state(
 }
 
 /// Turns expressions into the emitted functions of one model.
-pub(crate) struct Compiler {
+pub(crate) struct Compiler<'a> {
     inputs: Vec<Atom>,
     /// How many of the inputs are parameters (they come first), and how
     /// many coordinates follow them.
     params: usize,
     coords: usize,
     kind: Kind,
+    blame: Blame<'a>,
 }
 
-impl Compiler {
+/// Where a failure to compile a quantity is reported. Each quantity has
+/// a declaration to report at (q̈, h and Ȧq̇, which come from several, at
+/// the kinetic energy; a wall's at the wall), but a constant that
+/// overflows only once V or a constraint is differentiated (`10^308*y^2`:
+/// its gradient's 2·10^308) belongs to that declaration wherever it
+/// surfaces. So on a failure V's and the constraints' own derivatives are
+/// compiled alone, and the first that fails takes the error; else the
+/// quantity's own place does. Only on the failure path: a model that
+/// derives compiles nothing more.
+struct Blame<'a> {
+    sym: &'a symbols::Symbols<'a>,
+    raw: &'a mechanics::Raw,
+}
+
+impl Blame<'_> {
+    /// The place for a failure first reported at `span`.
+    fn place(&self, span: &Range<usize>) -> Range<usize> {
+        let (model, raw) = (self.sym.model, self.raw);
+        let fails = |derived: &[Atom]| evaluate::program(derived, &self.sym.inputs()).is_err();
+        if let Some(v) = &model.potential {
+            let mut derived = vec![raw.v.clone()];
+            derived.extend(self.sym.coords.iter().map(|q| raw.v.derivative(*q)));
+            if fails(&derived) {
+                return v.span.clone();
+            }
+        }
+        // A's rows: each holonomic constraint's dh, then the velocity-level
+        // constraints, each with its Ȧq̇.
+        let declared = model.holonomic.iter().chain(&model.constraints);
+        for (i, e) in declared.enumerate() {
+            let mut derived = raw.a_rows.get(i).cloned().unwrap_or_default();
+            derived.extend(raw.drift.get(i).cloned());
+            derived.extend(raw.holonomic.get(i).cloned());
+            if fails(&derived) {
+                return e.span.clone();
+            }
+        }
+        span.clone()
+    }
+}
+
+impl Compiler<'_> {
     /// The function for `quantity` computing `outputs` (`rows` of them in
     /// use, for rows and values); a failure is reported at `span`.
     fn program(
@@ -204,7 +250,7 @@ impl Compiler {
                 program,
                 rows,
             })
-            .map_err(|e| cx.error(ErrorKind::Symbolic(e), Some(span.clone())))
+            .map_err(|e| cx.error(ErrorKind::Symbolic(e), Some(self.blame.place(span))))
     }
 
     /// The cheapest of programs that compute the same outputs, the first

@@ -31,7 +31,7 @@ pub struct Context<'c, 'a> {
     /// G⁻¹, or `None` for structured evaluation.
     pub g_inv: Option<&'c Matrix<Field>>,
     /// Makes the emitted functions.
-    pub compile: &'c super::Compiler,
+    pub compile: &'c super::Compiler<'c>,
 }
 
 /// Every wall's derivation (a wall whose rows are all dependent has

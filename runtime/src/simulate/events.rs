@@ -495,15 +495,30 @@ mod tests {
         // longer say f must have fallen by much, but it rose.
         assert!(!explained(&at(0.0, 0.2, -1.0), &at(0.5, 3.0, -40.0), 0.01));
         // Motion along a wall: changes at rounding level are explained.
-        assert!(explained(&at(0.0, 0.5, 0.0), &at(1.0, 0.5 + 1e-16, 0.0), 1.0));
+        assert!(explained(
+            &at(0.0, 0.5, 0.0),
+            &at(1.0, 0.5 + 1e-16, 0.0),
+            1.0
+        ));
         // A sample at a pole is never explained.
-        assert!(!explained(&at(0.0, 0.5, -1.0), &at(1.0, f64::INFINITY, -1.0), 1.0));
-        assert!(!explained(&at(0.0, 0.5, -1.0), &at(1.0, 0.4, f64::NAN), 1.0));
+        assert!(!explained(
+            &at(0.0, 0.5, -1.0),
+            &at(1.0, f64::INFINITY, -1.0),
+            1.0
+        ));
+        assert!(!explained(
+            &at(0.0, 0.5, -1.0),
+            &at(1.0, 0.4, f64::NAN),
+            1.0
+        ));
     }
 
     #[test]
     fn shorter_steps_end_before_what_is_unresolved() {
-        let u = Unresolved { from: 0.25, to: 0.3 };
+        let u = Unresolved {
+            from: 0.25,
+            to: 0.3,
+        };
         assert_eq!(u.shorter(2.0), 0.5);
         let at_start = Unresolved { from: 0.0, to: 0.5 };
         assert_eq!(at_start.shorter(2.0), 0.5);
