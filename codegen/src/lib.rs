@@ -163,8 +163,9 @@ const ONE_OUTPUT: &str = "DALEMBERT_COMPILE_ONE_OUTPUT";
 /// Called from a build script (cargo has set `TARGET`, `HOST` and
 /// `OUT_DIR`), it derives each model in a process of its own: the build
 /// script runs again, once per model, and this call in it generates that
-/// model and exits, so call it before anything else the build script
-/// prints. symbolica's evaluator does not always give the same program for
+/// model alone and returns (no models, or that model's errors), so the
+/// build script should do nothing after it but report its errors and exit
+/// with failure on them. symbolica's evaluator does not always give the same program for
 /// a model derived after others in one process as for the model alone
 /// (`ARCHITECTURE.md`); this way the build script's code is what
 /// `dalembert generate` writes. Elsewhere, or where a process cannot be
@@ -173,10 +174,16 @@ const ONE_OUTPUT: &str = "DALEMBERT_COMPILE_ONE_OUTPUT";
 pub fn compile_dir(models_dir: &Path, out_dir: &Path) -> Result<Vec<Generated>, Vec<ModelErrors>> {
     if let (Some(model), Some(output)) = (std::env::var_os(ONE_MODEL), std::env::var_os(ONE_OUTPUT))
     {
-        // The process started for one model.
-        let ok =
-            generate(Path::new(&model)).is_ok_and(|code| std::fs::write(&output, code).is_ok());
-        std::process::exit(if ok { 0 } else { 1 });
+        // The process started for one model: its errors make the build
+        // script fail, which the starting process sees.
+        let (model, output) = (PathBuf::from(model), PathBuf::from(output));
+        let code = generate(&model).map_err(|e| vec![e])?;
+        if let Err(e) = std::fs::write(&output, code) {
+            let mut cx = diag::Collector::new(&model, "");
+            cx.error(ErrorKind::Io(format!("{}: {e}", output.display())), None);
+            return Err(vec![cx.into_errors()]);
+        }
+        return Ok(Vec::new());
     }
     let build_script = ["TARGET", "HOST", "OUT_DIR"]
         .iter()
