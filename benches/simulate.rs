@@ -12,7 +12,7 @@
 //! - `simulate/ball_bounce_{100,1000}_bounces`: the §3.2.1 nonholonomic
 //!   pendulum from the model file's initial state through 100 and 1000
 //!   bounces (throughput in bounces per second; the longer run takes more
-//!   steps per bounce, see docs/performance.md);
+//!   steps per bounce: the attitude drifts by rounding, docs/performance.md);
 //! - `simulate/rolling_ball_5s`: the §3.1 ball rolling under a uniform force
 //!   into the wall and back, 5 s of motion (throughput in steps per second).
 //!
