@@ -3,13 +3,12 @@
 //! one `sincos` call; parameter-only values stored once (`pre[k]`) and read
 //! per call (`self.pre[k]`).
 
-use std::collections::HashMap;
-
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
 use super::{Ctx, Scalar, ident};
-use crate::program::{Emit, Func, Instr, Program, Slot};
+use crate::program::machine::{Machine, Operand, lower, split};
+use crate::program::{Emit, Program, Slot};
 
 /// `f64` or `f32`.
 pub(super) fn real(d: &Ctx) -> TokenStream {
@@ -76,94 +75,129 @@ pub(super) fn statements(d: &Ctx, p: &Program, plan: &[Emit], place: Place) -> T
         let value = input_value(d, i, &params);
         quote! { let #name: #real = #value; }
     });
-    // sin and cos of a value share one sincos where both are computed here.
+    // Each instruction's machine form where it is computed here (sin and
+    // cos of a value share one sincos where both are).
     let computed = |i: usize| matches!(plan[i], Emit::Compute | Emit::Store(_));
-    let pairs = p.sincos_pairs();
-    let mut halves: HashMap<usize, usize> = HashMap::new();
-    for (i, pair) in pairs.iter().enumerate() {
-        if let Some((k, _)) = pair.filter(|_| computed(i)) {
-            *halves.entry(k).or_default() += 1;
-        }
-    }
-    let stmts = p
-        .instrs
-        .iter()
-        .zip(&pairs)
-        .enumerate()
-        .map(|(i, (ins, pair))| {
-            let computation = || match (ins, pair) {
-                (Instr::Fun(dst, f, src), Some(pair)) if halves.get(&pair.0) == Some(&2) => {
-                    sincos(d, p, *dst, *f, *src, *pair)
-                }
-                _ => instr(d, p, ins),
-            };
-            let dst = slot(d, p, ins.dst());
-            match (plan[i], place) {
-                (Emit::Skip, _) => TokenStream::new(),
-                (Emit::Compute, _) => computation(),
-                (Emit::Store(k), _) => {
-                    let (computation, k) = (computation(), Literal::usize_unsuffixed(k));
-                    quote! { #computation pre[#k] = #dst; }
-                }
-                (Emit::Load(k), _) => {
-                    let k = Literal::usize_unsuffixed(k);
-                    quote! { let #dst: #real = self.pre[#k]; }
-                }
-                (Emit::Leading(k, n), Place::Once) => {
-                    let k = Literal::usize_unsuffixed(k);
-                    let value = operation(d, p, ins, None, &ins.sources()[..n]);
-                    quote! { pre[#k] = #value; }
-                }
-                (Emit::Leading(k, n), Place::Call) => {
-                    let k = Literal::usize_unsuffixed(k);
-                    let stored = quote! { self.pre[#k] };
-                    let value = operation(d, p, ins, Some(stored), &ins.sources()[n..]);
-                    quote! { let #dst: #real = #value; }
-                }
+    let machine = lower(p, computed);
+    let stmts = p.instrs.iter().enumerate().map(|(i, ins)| {
+        let dst = ins.dst();
+        let slot_dst = slot(d, p, dst);
+        match (plan[i], place) {
+            (Emit::Skip, _) => TokenStream::new(),
+            (Emit::Compute, _) => statement(d, p, dst, machine[i].as_ref().unwrap()),
+            (Emit::Store(k), _) => {
+                let computation = statement(d, p, dst, machine[i].as_ref().unwrap());
+                let k = Literal::usize_unsuffixed(k);
+                quote! { #computation pre[#k] = #slot_dst; }
             }
-        });
+            (Emit::Load(k), _) => {
+                let k = Literal::usize_unsuffixed(k);
+                quote! { let #slot_dst: #real = self.pre[#k]; }
+            }
+            (Emit::Leading(k, n), Place::Once) => {
+                let value = expression(d, p, &split(p, ins, None, &ins.sources()[..n]));
+                let k = Literal::usize_unsuffixed(k);
+                quote! { pre[#k] = #value; }
+            }
+            (Emit::Leading(k, n), Place::Call) => {
+                let value = expression(d, p, &split(p, ins, Some(k), &ins.sources()[n..]));
+                quote! { let #slot_dst: #real = #value; }
+            }
+        }
+    });
     quote! { #(#inputs)* #(#stmts)* }
 }
 
-/// The sum or product `ins` computes, over `first` (a value already
-/// computed, standing for leading operands) and then `operands`.
-fn operation(
-    d: &Ctx,
-    p: &Program,
-    ins: &Instr,
-    first: Option<TokenStream>,
-    operands: &[Slot],
-) -> TokenStream {
-    match ins {
-        Instr::Add(..) => {
-            let rest = operands.iter().map(|&x| slot(d, p, x));
-            join(first.into_iter().chain(rest), quote! { + })
+/// `let dst = …;` for an instruction in machine form; the first of a
+/// sin/cos pair computes both into `sc{k}_sin` and `sc{k}_cos`, and each
+/// half takes its own.
+fn statement(d: &Ctx, p: &Program, dst: Slot, m: &Machine) -> TokenStream {
+    let real = real(d);
+    let dst = slot(d, p, dst);
+    let half = |pair: usize, sin: bool| {
+        let (s, c) = (format_ident!("sc{pair}_sin"), format_ident!("sc{pair}_cos"));
+        (if sin { s.clone() } else { c.clone() }, s, c)
+    };
+    match *m {
+        Machine::SinCos { x, pair, sin } => {
+            let (mine, s, c) = half(pair, sin);
+            let (call, x) = (libm_fn(d, "sincos"), slot(d, p, x));
+            quote! {
+                let (#s, #c): (#real, #real) = #call(#x);
+                let #dst: #real = #mine;
+            }
         }
-        Instr::Mul(..) => product(d, p, first, operands),
-        _ => unreachable!("only sums and products are split at leading operands"),
+        Machine::Half { pair, sin } => {
+            let mine = half(pair, sin).0;
+            quote! { let #dst: #real = #mine; }
+        }
+        _ => {
+            let value = expression(d, p, m);
+            quote! { let #dst: #real = #value; }
+        }
     }
 }
 
-/// One half of a sin/cos pair: the first computes both into `sc{k}_sin`
-/// and `sc{k}_cos`, each takes its own.
-fn sincos(
-    d: &Ctx,
-    p: &Program,
-    dst: Slot,
-    f: Func,
-    src: Slot,
-    (k, first): (usize, bool),
-) -> TokenStream {
-    let (s, c) = (format_ident!("sc{k}_sin"), format_ident!("sc{k}_cos"));
-    let real = real(d);
-    let both = first.then(|| {
-        let call = libm_fn(d, "sincos");
-        let src = slot(d, p, src);
-        quote! { let (#s, #c): (#real, #real) = #call(#src); }
-    });
-    let mine = if f == Func::Sin { s } else { c };
-    let dst = slot(d, p, dst);
-    quote! { #both let #dst: #real = #mine; }
+/// The value of an instruction in machine form as a Rust expression.
+fn expression(d: &Ctx, p: &Program, m: &Machine) -> TokenStream {
+    let operand = |o: &Operand| match *o {
+        Operand::Slot(s) => slot(d, p, s),
+        Operand::Kept(k) => {
+            let k = Literal::usize_unsuffixed(k);
+            quote! { self.pre[#k] }
+        }
+    };
+    let over = |reciprocal: bool, x: TokenStream| {
+        if reciprocal {
+            quote! { 1.0 / #x }
+        } else {
+            x
+        }
+    };
+    match m {
+        Machine::Sum(terms) => join(terms.iter().map(operand), quote! { + }),
+        Machine::Difference(a, b) => {
+            let (a, b) = (slot(d, p, *a), slot(d, p, *b));
+            quote! { #a - #b }
+        }
+        Machine::Product { factors, negate } => {
+            let product = join(factors.iter().map(operand), quote! { * });
+            if *negate {
+                quote! { -(#product) }
+            } else {
+                product
+            }
+        }
+        Machine::Number(x) => {
+            let a = Literal::f64_unsuffixed(x.abs());
+            if x.is_sign_negative() {
+                quote! { -#a }
+            } else {
+                quote! { #a }
+            }
+        }
+        Machine::Power { x, n, reciprocal } => {
+            let x = slot(d, p, *x);
+            let product = join(std::iter::repeat_n(x, *n as usize), quote! { * });
+            over(*reciprocal, quote! { (#product) })
+        }
+        Machine::Pow { x, e, reciprocal } => {
+            let (f, x, e) = (libm_fn(d, "pow"), slot(d, p, *x), lit(d, *e));
+            over(*reciprocal, quote! { #f(#x, #e) })
+        }
+        Machine::Sqrt { x, reciprocal } => {
+            let (f, x) = (libm_fn(d, "sqrt"), slot(d, p, *x));
+            over(*reciprocal, quote! { #f(#x) })
+        }
+        Machine::Call(f, x) => {
+            let (f, x) = (libm_fn(d, f.name()), slot(d, p, *x));
+            quote! { #f(#x) }
+        }
+        Machine::Copy(x) => slot(d, p, *x),
+        Machine::SinCos { .. } | Machine::Half { .. } => {
+            unreachable!("a sin/cos pair is a statement of its own")
+        }
+    }
 }
 
 /// Where input i of every program comes from: parameters, then coordinates,
@@ -196,51 +230,6 @@ pub(super) fn slot(d: &Ctx, p: &Program, s: Slot) -> TokenStream {
     quote! { #name }
 }
 
-fn instr(d: &Ctx, p: &Program, ins: &Instr) -> TokenStream {
-    let (dst, value) = match ins {
-        Instr::Add(o, s) => (*o, join(s.iter().map(|&x| slot(d, p, x)), quote! { + })),
-        Instr::Sub(o, s) => (*o, join(s.iter().map(|&x| slot(d, p, x)), quote! { - })),
-        Instr::Mul(o, s) => (*o, product(d, p, None, s)),
-        Instr::Pow(o, s, n) => (*o, pow(d, slot(d, p, *s), *n)),
-        Instr::Powf(o, s, x) => (*o, powf(d, slot(d, p, *s), *x)),
-        Instr::Fun(o, f, s) => {
-            let f = libm_fn(d, f.name());
-            let s = slot(d, p, *s);
-            (*o, quote! { #f(#s) })
-        }
-        Instr::Assign(o, s) => (*o, slot(d, p, *s)),
-    };
-    let dst = slot(d, p, dst);
-    let real = real(d);
-    quote! { let #dst: #real = #value; }
-}
-
-/// A product of `first` (if any) and `factors`; a factor −1 becomes a
-/// negation.
-fn product(d: &Ctx, p: &Program, first: Option<TokenStream>, factors: &[Slot]) -> TokenStream {
-    let minus_one = |s: &Slot| matches!(s, Slot::Const(i) if p.consts[*i] == -1.0);
-    let rest: Vec<TokenStream> = factors
-        .iter()
-        .filter(|s| !minus_one(s))
-        .map(|&x| slot(d, p, x))
-        .collect();
-    let negations = factors.iter().filter(|s| minus_one(s)).count();
-    let operands: Vec<TokenStream> = first.into_iter().chain(rest).collect();
-    if operands.is_empty() {
-        return if negations % 2 == 1 {
-            quote! { -1.0 }
-        } else {
-            quote! { 1.0 }
-        };
-    }
-    let prod = join(operands.into_iter(), quote! { * });
-    if negations % 2 == 1 {
-        quote! { -(#prod) }
-    } else {
-        prod
-    }
-}
-
 /// Operands joined by an operator: `a + b + c`.
 fn join(operands: impl Iterator<Item = TokenStream>, op: TokenStream) -> TokenStream {
     let mut out = TokenStream::new();
@@ -251,38 +240,4 @@ fn join(operands: impl Iterator<Item = TokenStream>, op: TokenStream) -> TokenSt
         out.extend(x);
     }
     out
-}
-
-fn pow(d: &Ctx, x: TokenStream, n: i64) -> TokenStream {
-    let m = n.unsigned_abs();
-    let positive = if m == 0 {
-        quote! { 1.0 }
-    } else if m <= 8 {
-        let product = join(std::iter::repeat_n(x.clone(), m as usize), quote! { * });
-        quote! { (#product) }
-    } else {
-        let e = lit(d, m as f64);
-        let f = libm_fn(d, "pow");
-        quote! { #f(#x, #e) }
-    };
-    if n < 0 {
-        quote! { 1.0 / #positive }
-    } else {
-        positive
-    }
-}
-
-/// x^e for a fractional constant e: a square root for ±½ (as
-/// [`crate::program::powf`] evaluates it), libm's pow otherwise.
-fn powf(d: &Ctx, x: TokenStream, e: f64) -> TokenStream {
-    let sqrt = libm_fn(d, "sqrt");
-    if e == 0.5 {
-        quote! { #sqrt(#x) }
-    } else if e == -0.5 {
-        quote! { 1.0 / #sqrt(#x) }
-    } else {
-        let f = libm_fn(d, "pow");
-        let e = lit(d, e);
-        quote! { #f(#x, #e) }
-    }
 }

@@ -17,7 +17,8 @@ use std::collections::HashMap;
 
 use dalembert_runtime::libm;
 
-use crate::program::{Func, Instr, Program, Slot};
+use crate::program::machine::{Machine, Operand, lower};
+use crate::program::{Func, Program, Slot};
 
 /// What an operation does.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -157,75 +158,88 @@ impl Builder {
         }
     }
 
-    /// The register of `ins`'s value.
-    fn translate(&mut self, p: &Program, ins: &Instr) -> u32 {
-        match ins {
-            Instr::Add(_, s) => {
-                let s: Vec<u32> = s.iter().map(|&x| self.read(x)).collect();
+    fn operand(&self, o: &Operand) -> u32 {
+        match *o {
+            Operand::Slot(s) => self.read(s),
+            Operand::Kept(_) => unreachable!("the interpreter keeps no values per parameter set"),
+        }
+    }
+
+    /// The register of an instruction's value, from its machine form: one
+    /// operation for each the emitted statement performs, in its order.
+    fn translate(&mut self, m: &Machine, pairs: &mut HashMap<usize, (u32, u32)>) -> u32 {
+        let over = |b: &mut Self, reciprocal: bool, x: u32| {
+            if reciprocal {
+                b.unary(Kind::Recip, x)
+            } else {
+                x
+            }
+        };
+        match m {
+            Machine::Sum(terms) => {
+                let s: Vec<u32> = terms.iter().map(|o| self.operand(o)).collect();
                 self.nary(&s, Kind::Add, Kind::Sum)
             }
-            Instr::Sub(_, [x, y]) => {
+            Machine::Difference(x, y) => {
                 let (a, b) = (self.read(*x), self.read(*y));
                 self.push(Kind::Sub, a, b, &[a, b])
             }
-            Instr::Mul(_, s) => {
-                // As emitted: factors −1 dropped, the product negated when
-                // their number is odd.
-                let minus_one = |x: &Slot| matches!(x, Slot::Const(i) if p.consts[*i] == -1.0);
-                let rest: Vec<u32> = s
-                    .iter()
-                    .filter(|x| !minus_one(x))
-                    .map(|&x| self.read(x))
-                    .collect();
-                let negate = (s.len() - rest.len()) % 2 == 1;
-                if rest.is_empty() {
-                    let one = if negate { -1.0 } else { 1.0 };
-                    return self.with_number(Kind::Set, 0, one, &[]);
-                }
-                let product = self.nary(&rest, Kind::Mul, Kind::Product);
-                if negate {
+            Machine::Product { factors, negate } => {
+                let s: Vec<u32> = factors.iter().map(|o| self.operand(o)).collect();
+                let product = self.nary(&s, Kind::Mul, Kind::Product);
+                if *negate {
                     self.unary(Kind::Neg, product)
                 } else {
                     product
                 }
             }
-            Instr::Pow(_, s, n) => {
-                let (a, m) = (self.read(*s), n.unsigned_abs());
-                let positive = match m {
-                    0 => self.with_number(Kind::Set, 0, 1.0, &[]),
+            Machine::Number(x) => self.with_number(Kind::Set, 0, *x, &[]),
+            Machine::Power { x, n, reciprocal } => {
+                let a = self.read(*x);
+                let power = match n {
                     1 => a,
-                    2..=8 => self.push(Kind::Power, a, m as u32, &[a]),
-                    _ => self.with_number(Kind::Pow, a, m as f64, &[a]),
+                    _ => self.push(Kind::Power, a, *n, &[a]),
                 };
-                if *n < 0 {
-                    self.unary(Kind::Recip, positive)
-                } else {
-                    positive
-                }
+                over(self, *reciprocal, power)
             }
-            Instr::Powf(_, s, e) => {
-                let a = self.read(*s);
-                if *e == 0.5 {
-                    self.unary(Kind::Sqrt, a)
-                } else if *e == -0.5 {
-                    self.unary(Kind::RecipSqrt, a)
-                } else {
-                    self.with_number(Kind::Pow, a, *e, &[a])
-                }
+            Machine::Pow { x, e, reciprocal } => {
+                let a = self.read(*x);
+                let power = self.with_number(Kind::Pow, a, *e, &[a]);
+                over(self, *reciprocal, power)
             }
-            Instr::Fun(_, f, s) => {
-                let a = self.read(*s);
+            Machine::Sqrt { x, reciprocal } => {
+                let a = self.read(*x);
+                let kind = if *reciprocal {
+                    Kind::RecipSqrt
+                } else {
+                    Kind::Sqrt
+                };
+                self.unary(kind, a)
+            }
+            Machine::Call(f, x) => {
+                let a = self.read(*x);
                 let kind = match f {
                     Func::Sin => Kind::Sin,
                     Func::Cos => Kind::Cos,
                     Func::Exp => Kind::Exp,
                     Func::Log => Kind::Log,
-                    Func::Sqrt => Kind::Sqrt,
+                    Func::Sqrt => unreachable!("a square root is Machine::Sqrt"),
                 };
                 self.unary(kind, a)
             }
+            Machine::SinCos { x, pair, sin } => {
+                let a = self.read(*x);
+                let (s, c) = (self.fresh(&[a]), self.fresh(&[a]));
+                self.ops.push((Kind::SinCos, Op { d: s, a, b: c }));
+                pairs.insert(*pair, (s, c));
+                if *sin { s } else { c }
+            }
+            Machine::Half { pair, sin } => {
+                let (s, c) = pairs[pair];
+                if *sin { s } else { c }
+            }
             // A copy needs no operation: the slot now names the value's register.
-            Instr::Assign(_, s) => self.read(*s),
+            Machine::Copy(x) => self.read(*x),
         }
     }
 }
@@ -249,23 +263,9 @@ impl Tape {
         for k in 0..p.consts.len() {
             b.current.insert(Slot::Const(k), (p.inputs + k) as u32);
         }
-        // sin and cos of one value: the first of the pair computes both.
-        let mut pair_registers: HashMap<usize, (u32, u32)> = HashMap::new();
-        for (ins, pair) in p.instrs.iter().zip(p.sincos_pairs()) {
-            let value = match (ins, pair) {
-                (Instr::Fun(_, f, x), Some((k, first))) => {
-                    if first {
-                        let a = b.read(*x);
-                        let sin = b.fresh(&[a]);
-                        let cos = b.fresh(&[a]);
-                        b.ops.push((Kind::SinCos, Op { d: sin, a, b: cos }));
-                        pair_registers.insert(k, (sin, cos));
-                    }
-                    let (sin, cos) = pair_registers[&k];
-                    if *f == Func::Sin { sin } else { cos }
-                }
-                _ => b.translate(p, ins),
-            };
+        let mut pairs: HashMap<usize, (u32, u32)> = HashMap::new();
+        for (ins, m) in p.instrs.iter().zip(lower(p, |_| true)) {
+            let value = b.translate(&m.expect("every instruction is computed"), &mut pairs);
             b.current.insert(ins.dst(), value);
         }
         let outputs: Vec<u32> = (0..p.outputs).map(|i| b.read(Slot::Out(i))).collect();
@@ -372,6 +372,7 @@ impl Tape {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::program::Instr;
 
     fn run(p: &Program, inputs: &[f64]) -> Vec<f64> {
         let t = Tape::new(p);

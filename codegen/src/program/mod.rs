@@ -8,6 +8,7 @@
 mod elimination;
 mod hoist;
 mod linear;
+pub mod machine;
 mod taylor;
 
 use std::collections::HashMap;

@@ -1,0 +1,268 @@
+//! A program's instructions in machine form: every arithmetic decision the
+//! back ends would otherwise each make, made here once. A factor −1 is a
+//! negation of the product; xⁿ is n − 1 products up to n = 8 and libm's pow
+//! above; x^±½ is a square root; sin and cos of one value are one `sincos`
+//! where both are computed; a product of −1s alone is the number ±1. The
+//! emitter writes each [`Machine`] as one Rust statement and the
+//! interpreter as register operations, neither deciding anything of its
+//! own, so the two compute the same floating-point numbers.
+
+use super::{Func, Instr, Program, Slot};
+
+/// An operand: a slot of the program, or a parameter-only value kept in the
+/// model (`pre[k]`, see [`super::Emit`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Operand {
+    /// A slot.
+    Slot(Slot),
+    /// The k-th kept value.
+    Kept(usize),
+}
+
+/// One instruction in machine form.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Machine {
+    /// Σ operands, left to right (one operand: that value).
+    Sum(Vec<Operand>),
+    /// a − b
+    Difference(Slot, Slot),
+    /// Π factors, left to right (one factor: that value), negated when
+    /// `negate`; never without factors (that is [`Machine::Number`]).
+    Product {
+        /// The factors, −1s removed.
+        factors: Vec<Operand>,
+        /// Whether the number of −1s removed was odd.
+        negate: bool,
+    },
+    /// The number x.
+    Number(f64),
+    /// x · x · … · x (`n` factors, 1 ≤ n ≤ 8), or 1 over it.
+    Power {
+        /// The base.
+        x: Slot,
+        /// The number of factors.
+        n: u32,
+        /// 1 over the product.
+        reciprocal: bool,
+    },
+    /// libm's pow(x, e), or 1 over it.
+    Pow {
+        /// The base.
+        x: Slot,
+        /// The exponent.
+        e: f64,
+        /// 1 over the power.
+        reciprocal: bool,
+    },
+    /// libm's sqrt(x), or 1 over it.
+    Sqrt {
+        /// The argument.
+        x: Slot,
+        /// 1 over the root.
+        reciprocal: bool,
+    },
+    /// libm's sin, cos, exp or log of x (never sqrt: that is
+    /// [`Machine::Sqrt`]).
+    Call(Func, Slot),
+    /// The first of a sin/cos pair: libm's sincos(x) computes both, and
+    /// this instruction takes the sine (`sin`) or the cosine.
+    SinCos {
+        /// The argument.
+        x: Slot,
+        /// The pair's number ([`Program::sincos_pairs`]).
+        pair: usize,
+        /// Whether this instruction is the sine.
+        sin: bool,
+    },
+    /// The second of a sin/cos pair: the half its first computed.
+    Half {
+        /// The pair's number.
+        pair: usize,
+        /// Whether this instruction is the sine.
+        sin: bool,
+    },
+    /// A copy of a slot.
+    Copy(Slot),
+}
+
+/// Each instruction of `p` in machine form, `None` where `computed` says it
+/// is not computed here; sin and cos of one value are a pair where both are
+/// computed.
+pub fn lower(p: &Program, computed: impl Fn(usize) -> bool) -> Vec<Option<Machine>> {
+    let pairs = p.sincos_pairs();
+    // How many halves of each pair are computed.
+    let mut halves = vec![0usize; pairs.iter().flatten().count() / 2];
+    for (i, pair) in pairs.iter().enumerate() {
+        if let Some((k, _)) = pair.filter(|_| computed(i)) {
+            halves[k] += 1;
+        }
+    }
+    (p.instrs.iter().zip(&pairs).enumerate())
+        .map(|(i, (ins, pair))| {
+            if !computed(i) {
+                return None;
+            }
+            Some(match (ins, pair) {
+                (Instr::Fun(_, f, x), Some((k, first))) if halves[*k] == 2 => {
+                    let sin = *f == Func::Sin;
+                    if *first {
+                        Machine::SinCos {
+                            x: *x,
+                            pair: *k,
+                            sin,
+                        }
+                    } else {
+                        Machine::Half { pair: *k, sin }
+                    }
+                }
+                _ => instruction(p, ins),
+            })
+        })
+        .collect()
+}
+
+/// `ins` alone in machine form (sin and cos not paired).
+fn instruction(p: &Program, ins: &Instr) -> Machine {
+    match ins {
+        Instr::Add(_, s) => Machine::Sum(s.iter().map(|&x| Operand::Slot(x)).collect()),
+        Instr::Sub(_, [a, b]) => Machine::Difference(*a, *b),
+        Instr::Mul(_, s) => product(p, None, s),
+        Instr::Pow(_, x, n) => {
+            let (m, reciprocal) = (n.unsigned_abs(), *n < 0);
+            match m {
+                0 => Machine::Number(1.0),
+                1..=8 => Machine::Power {
+                    x: *x,
+                    n: m as u32,
+                    reciprocal,
+                },
+                _ => Machine::Pow {
+                    x: *x,
+                    e: m as f64,
+                    reciprocal,
+                },
+            }
+        }
+        Instr::Powf(_, x, e) if e.abs() == 0.5 => Machine::Sqrt {
+            x: *x,
+            reciprocal: *e < 0.0,
+        },
+        Instr::Powf(_, x, e) => Machine::Pow {
+            x: *x,
+            e: *e,
+            reciprocal: false,
+        },
+        Instr::Fun(_, Func::Sqrt, x) => Machine::Sqrt {
+            x: *x,
+            reciprocal: false,
+        },
+        Instr::Fun(_, f, x) => Machine::Call(*f, *x),
+        Instr::Assign(_, x) => Machine::Copy(*x),
+    }
+}
+
+/// The sum or product `ins` computes over the kept value `first` (standing
+/// for operands computed once per parameter set), if any, and `operands`.
+pub fn split(p: &Program, ins: &Instr, first: Option<usize>, operands: &[Slot]) -> Machine {
+    match ins {
+        Instr::Add(..) => Machine::Sum(
+            (first.map(Operand::Kept).into_iter())
+                .chain(operands.iter().map(|&x| Operand::Slot(x)))
+                .collect(),
+        ),
+        Instr::Mul(..) => product(p, first, operands),
+        _ => unreachable!("only sums and products are split at leading operands"),
+    }
+}
+
+/// A product of `first` (if any) and `factors`: factors −1 dropped, the
+/// product negated when their number is odd, ±1 when nothing is left.
+fn product(p: &Program, first: Option<usize>, factors: &[Slot]) -> Machine {
+    let minus_one = |s: &Slot| matches!(s, Slot::Const(i) if p.consts[*i] == -1.0);
+    let negate = factors.iter().filter(|s| minus_one(s)).count() % 2 == 1;
+    let factors: Vec<Operand> = (first.map(Operand::Kept).into_iter())
+        .chain(
+            factors
+                .iter()
+                .filter(|s| !minus_one(s))
+                .map(|&x| Operand::Slot(x)),
+        )
+        .collect();
+    if factors.is_empty() {
+        Machine::Number(if negate { -1.0 } else { 1.0 })
+    } else {
+        Machine::Product { factors, negate }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every decision in one place: −1 factors, powers by size and sign,
+    /// ±½ powers, and sin/cos pairs only where both halves are computed.
+    #[test]
+    fn decisions() {
+        let (x, y) = (Slot::Input(0), Slot::Input(1));
+        let p = Program {
+            inputs: 2,
+            consts: vec![-1.0],
+            instrs: vec![
+                Instr::Mul(Slot::Out(0), vec![Slot::Const(0), x, Slot::Const(0), y]),
+                Instr::Mul(Slot::Out(1), vec![Slot::Const(0)]),
+                Instr::Pow(Slot::Out(2), x, -3),
+                Instr::Pow(Slot::Out(3), x, 9),
+                Instr::Powf(Slot::Out(4), x, -0.5),
+                Instr::Fun(Slot::Out(5), Func::Cos, y),
+                Instr::Fun(Slot::Out(6), Func::Sin, y),
+            ],
+            outputs: 7,
+        };
+        let all = lower(&p, |_| true);
+        let slots = |s: &[Slot]| s.iter().map(|&s| Operand::Slot(s)).collect();
+        assert_eq!(
+            all,
+            vec![
+                Some(Machine::Product {
+                    factors: slots(&[x, y]),
+                    negate: false
+                }),
+                Some(Machine::Number(-1.0)),
+                Some(Machine::Power {
+                    x,
+                    n: 3,
+                    reciprocal: true
+                }),
+                Some(Machine::Pow {
+                    x,
+                    e: 9.0,
+                    reciprocal: false
+                }),
+                Some(Machine::Sqrt {
+                    x,
+                    reciprocal: true
+                }),
+                Some(Machine::SinCos {
+                    x: y,
+                    pair: 0,
+                    sin: false
+                }),
+                Some(Machine::Half { pair: 0, sin: true }),
+            ]
+        );
+        // The cosine computed elsewhere (kept once per parameter set): the
+        // sine is a call of its own.
+        let some = lower(&p, |i| i != 5);
+        assert_eq!(some[5], None);
+        assert_eq!(some[6], Some(Machine::Call(Func::Sin, y)));
+        // A product split after a kept value.
+        let ins = &p.instrs[0];
+        assert_eq!(
+            split(&p, ins, Some(3), &[Slot::Const(0), y]),
+            Machine::Product {
+                factors: vec![Operand::Kept(3), Operand::Slot(y)],
+                negate: true
+            }
+        );
+    }
+}
