@@ -37,12 +37,7 @@ fn alone(test: &str) -> bool {
     if std::env::var_os(CHILD).is_some() {
         return true;
     }
-    let status = std::process::Command::new(std::env::current_exe().unwrap())
-        .args(["--exact", test, "--test-threads=1"])
-        .env(CHILD, "1")
-        .status()
-        .unwrap();
-    assert!(status.success(), "{test} failed in its own process");
+    common::in_child(test, false, &[(CHILD, "1".as_ref())]);
     false
 }
 

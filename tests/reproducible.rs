@@ -5,7 +5,6 @@
 //! life of a process), so this file holds only these tests.
 
 use std::path::Path;
-use std::process::Command;
 
 mod common;
 
@@ -43,6 +42,7 @@ fn chain_3() -> std::path::PathBuf {
 /// generated code (or that of the model file `DALEMBERT_MODEL` names) to
 /// the file the parent names.
 #[test]
+#[ignore = "runs only in the child process the other tests start"]
 fn generate_in_child() {
     let Ok(out) = std::env::var(CHILD) else {
         return; // not a child: nothing to do
@@ -66,18 +66,14 @@ fn generated(model: Option<&Path>, prelude: bool, tag: &str) -> String {
         "dalembert-reproducible-{}-{tag}.rs",
         std::process::id()
     ));
-    let mut child = Command::new(std::env::current_exe().unwrap());
-    child
-        .args(["--exact", "generate_in_child", "--test-threads=1"])
-        .env(CHILD, &out);
+    let mut env = vec![(CHILD, out.as_os_str())];
     if prelude {
-        child.env("DALEMBERT_PRELUDE", "1");
+        env.push(("DALEMBERT_PRELUDE", "1".as_ref()));
     }
     if let Some(m) = model {
-        child.env("DALEMBERT_MODEL", m);
+        env.push(("DALEMBERT_MODEL", m.as_os_str()));
     }
-    let status = child.status().unwrap();
-    assert!(status.success(), "the child process failed");
+    common::in_child("generate_in_child", true, &env);
     let code = std::fs::read_to_string(&out).unwrap();
     std::fs::remove_file(&out).unwrap();
     code
@@ -87,9 +83,6 @@ fn generated(model: Option<&Path>, prelude: bool, tag: &str) -> String {
 /// in the opposite order: the same file.
 #[test]
 fn generated_code_does_not_depend_on_earlier_derivations() {
-    if std::env::var(CHILD).is_ok() {
-        return;
-    }
     let alone = generated(None, false, "alone");
     let after = generated(None, true, "after");
     assert!(alone.contains("pub fn floor_collide"));
@@ -106,9 +99,6 @@ fn generated_code_does_not_depend_on_earlier_derivations() {
 /// derives each model in a process of its own.)
 #[test]
 fn build_script_output_matches_each_model_generated_alone() {
-    if std::env::var(CHILD).is_ok() {
-        return;
-    }
     let files = common::model_files();
     assert!(files.len() > 10, "the built-in models are missing");
     let mut differ = Vec::new();

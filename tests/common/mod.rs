@@ -104,3 +104,25 @@ pub fn dormand_prince(rtol: f64) -> Settings {
         ..Settings::default()
     }
 }
+
+/// Runs `test` of this test binary in a process of its own (with `env`
+/// set, and `--ignored` for a test that runs only there) and asserts that
+/// it passed. Its output is shown only when it failed, so the suite's
+/// report counts each test once.
+pub fn in_child(test: &str, ignored: bool, env: &[(&str, &std::ffi::OsStr)]) {
+    let mut child = std::process::Command::new(std::env::current_exe().unwrap());
+    child.args(["--exact", test, "--test-threads=1"]);
+    if ignored {
+        child.arg("--ignored");
+    }
+    for (name, value) in env {
+        child.env(name, value);
+    }
+    let out = child.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{test} failed in its own process:\n{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
