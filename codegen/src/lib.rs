@@ -151,6 +151,13 @@ pub struct Generated {
     pub n: usize,
 }
 
+/// A model's code not generated: `why`, reported at the model file.
+fn generation_error(model_file: &Path, why: String) -> ModelErrors {
+    let mut cx = diag::Collector::new(model_file, "");
+    cx.error(ErrorKind::Generation(why), None);
+    cx.into_errors()
+}
+
 /// Set in a process [`compile_dir`] starts for one model: the model file,
 /// and the file to write its code to.
 const ONE_MODEL: &str = "DALEMBERT_COMPILE_ONE_MODEL";
@@ -169,8 +176,10 @@ const ONE_OUTPUT: &str = "DALEMBERT_COMPILE_ONE_OUTPUT";
 /// a model derived after others in one process as for the model alone
 /// (`ARCHITECTURE.md`); this way the build script's code is what
 /// `dalembert generate` writes. Elsewhere, or where a process cannot be
-/// started, and for a model whose process fails (to collect its errors),
-/// the model is derived in this process.
+/// started, the model is derived in this process. A model whose process
+/// fails is derived here for its errors; if it has none, the failure
+/// itself is the error (with the process's exit status and standard
+/// error), and no code is written for it.
 pub fn compile_dir(models_dir: &Path, out_dir: &Path) -> Result<Vec<Generated>, Vec<ModelErrors>> {
     if let (Some(model), Some(output)) = (std::env::var_os(ONE_MODEL), std::env::var_os(ONE_OUTPUT))
     {
@@ -179,9 +188,10 @@ pub fn compile_dir(models_dir: &Path, out_dir: &Path) -> Result<Vec<Generated>, 
         let (model, output) = (PathBuf::from(model), PathBuf::from(output));
         let code = generate(&model).map_err(|e| vec![e])?;
         if let Err(e) = std::fs::write(&output, code) {
-            let mut cx = diag::Collector::new(&model, "");
-            cx.error(ErrorKind::Io(format!("{}: {e}", output.display())), None);
-            return Err(vec![cx.into_errors()]);
+            return Err(vec![generation_error(
+                &model,
+                format!("{}: {e}", output.display()),
+            )]);
         }
         return Ok(Vec::new());
     }
@@ -220,38 +230,54 @@ pub fn compile_dir(models_dir: &Path, out_dir: &Path) -> Result<Vec<Generated>, 
             q: model.coordinates.len(),
             n: model.velocities.len(),
         };
-        let alone = build_script
-            && std::env::current_exe().is_ok_and(|exe| {
-                std::process::Command::new(exe)
-                    .env(ONE_MODEL, &generated.model_file)
-                    .env(ONE_OUTPUT, &generated.rust_file)
-                    .stdout(std::process::Stdio::null())
-                    .stderr(std::process::Stdio::null())
-                    .status()
-                    .is_ok_and(|s| s.success())
-            });
-        if alone {
-            done.push(generated);
-        } else {
-            here.push((model, generated));
+        if !build_script {
+            here.push((model, generated, None));
+            continue;
+        }
+        let started = std::env::current_exe().and_then(|exe| {
+            std::process::Command::new(exe)
+                .env(ONE_MODEL, &generated.model_file)
+                .env(ONE_OUTPUT, &generated.rust_file)
+                .stdout(std::process::Stdio::null())
+                .stderr(std::process::Stdio::piped())
+                .output()
+        });
+        match started {
+            Ok(out) if out.status.success() => done.push(generated),
+            // Derived here only for its errors (below).
+            Ok(out) => {
+                let stderr = String::from_utf8_lossy(&out.stderr);
+                let failure = match stderr.trim() {
+                    "" => out.status.to_string(),
+                    said => format!("{}; it wrote: {said}", out.status),
+                };
+                here.push((model, generated, Some(failure)));
+            }
+            // No process could be started: derived here.
+            Err(_) => here.push((model, generated, None)),
         }
     }
-    for (model, generated) in here {
-        match derive::derive(&model) {
-            Ok(d) => {
-                if let Err(e) = emittable(&d, Options::default()) {
-                    errors.push(e);
-                    continue;
-                }
-                let rust_file = &generated.rust_file;
-                if let Err(e) = std::fs::write(rust_file, emit::file(&d, Options::default())) {
-                    let mut cx = diag::Collector::new(&generated.model_file, "");
-                    cx.error(ErrorKind::Io(format!("{}: {e}", rust_file.display())), None);
-                    errors.push(cx.into_errors());
-                    continue;
-                }
-                done.push(generated);
-            }
+    for (model, generated, failed) in here {
+        let code = derive::derive(&model).and_then(|d| {
+            emittable(&d, Options::default())?;
+            Ok(emit::file(&d, Options::default()))
+        });
+        let written = match (code, failed) {
+            (Err(e), _) => Err(e),
+            // The model derives here, yet its own process failed: its code
+            // here could differ from what it would be alone, so it is not
+            // written.
+            (Ok(_), Some(failure)) => Err(generation_error(
+                &generated.model_file,
+                format!("the process started to generate it alone failed ({failure})"),
+            )),
+            (Ok(code), None) => std::fs::write(&generated.rust_file, code).map_err(|e| {
+                let file = generated.rust_file.display();
+                generation_error(&generated.model_file, format!("{file}: {e}"))
+            }),
+        };
+        match written {
+            Ok(()) => done.push(generated),
             Err(e) => errors.push(e),
         }
     }
@@ -260,10 +286,10 @@ pub fn compile_dir(models_dir: &Path, out_dir: &Path) -> Result<Vec<Generated>, 
     }
     done.sort_by(|a, b| a.model_file.cmp(&b.model_file));
     let index = emit::index(&done);
-    if let Err(e) = std::fs::write(out_dir.join("models.rs"), index) {
-        let mut cx = diag::Collector::new(models_dir, "");
-        cx.error(ErrorKind::Io(e.to_string()), None);
-        return Err(vec![cx.into_errors()]);
+    let index_file = out_dir.join("models.rs");
+    if let Err(e) = std::fs::write(&index_file, index) {
+        let why = format!("{}: {e}", index_file.display());
+        return Err(vec![generation_error(models_dir, why)]);
     }
     Ok(done)
 }
