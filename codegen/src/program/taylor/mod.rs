@@ -16,6 +16,7 @@ use std::collections::HashMap;
 
 use dalembert_runtime::taylor::Work;
 
+use super::machine::{Machine, lower};
 use super::{Func, Instr, Program, Slot, constant};
 
 mod evaluate;
@@ -149,8 +150,11 @@ impl<'a> Builder<'a> {
     }
 
     fn run(mut self) -> Transform {
-        for ins in &self.p.instrs {
-            let value = self.instr(ins);
+        // Powers and square roots as the machine form has them (every
+        // instruction computed: the series has no kept values).
+        let machine = lower(self.p, |_| true);
+        for (ins, m) in self.p.instrs.iter().zip(machine) {
+            let value = self.instr(ins, &m.expect("every instruction is computed"));
             self.bound.insert(ins.dst(), value);
         }
         let mut outputs: Vec<Term> = (0..self.p.outputs)
@@ -205,7 +209,8 @@ impl<'a> Builder<'a> {
         dst
     }
 
-    fn instr(&mut self, ins: &Instr) -> Term {
+    /// The series of `ins`, whose machine form is `m`.
+    fn instr(&mut self, ins: &Instr, m: &Machine) -> Term {
         let terms: Vec<Term> = ins.sources().iter().map(|&s| self.term(s)).collect();
         let numbers: Option<Vec<Slot>> = terms
             .iter()
@@ -241,64 +246,60 @@ impl<'a> Builder<'a> {
                 }
                 acc
             }
-            Instr::Pow(_, _, n) => {
+            Instr::Pow(..) | Instr::Powf(..) | Instr::Fun(..) => {
                 let a = series_of(&terms[0]);
-                let m = n.unsigned_abs();
-                let positive = if m == 0 {
-                    return Term::Number(constant(&mut self.numbers.consts, 1.0));
-                } else if m <= 8 {
-                    let mut acc = Term::Series(a);
-                    for _ in 1..m {
-                        acc = self.times(acc, Term::Series(a));
-                    }
-                    series_of(&acc)
-                } else {
-                    return Term::Series(self.op(|dst| Op::Power {
-                        dst,
-                        a,
-                        alpha: *n as f64,
-                    }));
-                };
-                if *n < 0 {
-                    Term::Series(self.op(|dst| Op::Recip { dst, a: positive }))
-                } else {
-                    Term::Series(positive)
-                }
-            }
-            Instr::Powf(_, _, e) => {
-                let a = series_of(&terms[0]);
-                if *e == 0.5 || *e == -0.5 {
-                    let root = self.op(|dst| Op::Sqrt { dst, a });
-                    if *e < 0.0 {
-                        Term::Series(self.op(|dst| Op::Recip { dst, a: root }))
+                let over = |b: &mut Self, reciprocal: bool, x: Series| {
+                    Term::Series(if reciprocal {
+                        b.op(|dst| Op::Recip { dst, a: x })
                     } else {
-                        Term::Series(root)
+                        x
+                    })
+                };
+                match *m {
+                    Machine::Number(x) => Term::Number(constant(&mut self.numbers.consts, x)),
+                    Machine::Power { n, reciprocal, .. } => {
+                        let mut acc = Term::Series(a);
+                        for _ in 1..n {
+                            acc = self.times(acc, Term::Series(a));
+                        }
+                        over(self, reciprocal, series_of(&acc))
                     }
-                } else {
-                    Term::Series(self.op(|dst| Op::Power { dst, a, alpha: *e }))
+                    Machine::Pow { e, reciprocal, .. } => {
+                        let alpha = if reciprocal { -e } else { e };
+                        Term::Series(self.op(|dst| Op::Power { dst, a, alpha }))
+                    }
+                    Machine::Sqrt { reciprocal, .. } => {
+                        let root = self.op(|dst| Op::Sqrt { dst, a });
+                        over(self, reciprocal, root)
+                    }
+                    Machine::Call(Func::Exp, _) => Term::Series(self.op(|dst| Op::Exp { dst, a })),
+                    Machine::Call(Func::Log, _) => Term::Series(self.op(|dst| Op::Log { dst, a })),
+                    // sin and cos of one series share one pair of series,
+                    // whichever slots they came through.
+                    Machine::Call(f @ (Func::Sin | Func::Cos), _) => {
+                        Term::Series(self.sin_cos(a, f == Func::Sin))
+                    }
+                    Machine::SinCos { sin, .. } | Machine::Half { sin, .. } => {
+                        Term::Series(self.sin_cos(a, sin))
+                    }
+                    _ => unreachable!("{m:?} is not the machine form of a power or function"),
                 }
-            }
-            Instr::Fun(_, f, _) => {
-                let a = series_of(&terms[0]);
-                Term::Series(match f {
-                    Func::Sin | Func::Cos => {
-                        let (s, c) = match self.trig.get(&a) {
-                            Some(pair) => *pair,
-                            None => {
-                                let (sin, cos) = (self.temp(), self.temp());
-                                self.ops.push(Op::SinCos { sin, cos, a });
-                                self.trig.insert(a, (sin, cos));
-                                (sin, cos)
-                            }
-                        };
-                        if *f == Func::Sin { s } else { c }
-                    }
-                    Func::Exp => self.op(|dst| Op::Exp { dst, a }),
-                    Func::Log => self.op(|dst| Op::Log { dst, a }),
-                    Func::Sqrt => self.op(|dst| Op::Sqrt { dst, a }),
-                })
             }
         }
+    }
+
+    /// The sine (`sin`) or cosine of series `a`, both made at the first.
+    fn sin_cos(&mut self, a: Series, sin: bool) -> Series {
+        let (s, c) = match self.trig.get(&a) {
+            Some(pair) => *pair,
+            None => {
+                let (sin, cos) = (self.temp(), self.temp());
+                self.ops.push(Op::SinCos { sin, cos, a });
+                self.trig.insert(a, (sin, cos));
+                (sin, cos)
+            }
+        };
+        if sin { s } else { c }
     }
 
     /// Σ terms, at least one of them a series.
