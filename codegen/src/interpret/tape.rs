@@ -434,5 +434,10 @@ mod tests {
         for (g, w) in got.iter().zip(want) {
             assert_eq!(g.to_bits(), w.to_bits(), "{got:?} vs {want:?}");
         }
+        // The reference evaluation reads the same machine form.
+        let reference = p.eval(&[a, b]);
+        for (g, r) in got.iter().zip(&reference) {
+            assert_eq!(g.to_bits(), r.to_bits(), "{got:?} vs {reference:?}");
+        }
     }
 }

@@ -7,6 +7,8 @@
 //! interpreter as register operations, neither deciding anything of its
 //! own, so the two compute the same floating-point numbers.
 
+use std::collections::HashMap;
+
 use super::{Func, Instr, Program, Slot};
 
 /// An operand: a slot of the program, or a parameter-only value kept in the
@@ -193,6 +195,77 @@ fn product(p: &Program, first: Option<usize>, factors: &[Slot]) -> Machine {
     } else {
         Machine::Product { factors, negate }
     }
+}
+
+/// Runs `p` on `inputs` with the arithmetic of its machine form, the
+/// operations of the emitted code in its order with the same libm
+/// functions: the reference evaluation the generator's own checks use.
+pub fn run(p: &Program, inputs: &[f64]) -> Vec<f64> {
+    use dalembert_runtime::libm;
+    let mut temps: Vec<f64> = Vec::new();
+    let mut outs = vec![0.0; p.outputs];
+    let mut pairs: HashMap<usize, (f64, f64)> = HashMap::new();
+    for (ins, m) in p.instrs.iter().zip(lower(p, |_| true)) {
+        let get = |s: Slot| match s {
+            Slot::Input(i) => inputs[i],
+            Slot::Const(i) => p.consts[i],
+            Slot::Temp(i) => temps[i],
+            Slot::Out(i) => outs[i],
+        };
+        let operand = |o: &Operand| match *o {
+            Operand::Slot(s) => get(s),
+            Operand::Kept(_) => unreachable!("every instruction is computed"),
+        };
+        let fold = |xs: &[Operand], f: fn(f64, f64) -> f64| {
+            (xs.iter().map(operand)).reduce(f).unwrap_or(0.0)
+        };
+        let over = |reciprocal: bool, x: f64| if reciprocal { 1.0 / x } else { x };
+        let value = match m.expect("every instruction is computed") {
+            Machine::Sum(terms) => fold(&terms, |a, b| a + b),
+            Machine::Difference(a, b) => get(a) - get(b),
+            Machine::Product { factors, negate } => {
+                let product = fold(&factors, |a, b| a * b);
+                if negate { -product } else { product }
+            }
+            Machine::Number(x) => x,
+            Machine::Power { x, n, reciprocal } => {
+                let x = get(x);
+                over(reciprocal, (1..n).fold(x, |acc, _| acc * x))
+            }
+            Machine::Pow { x, e, reciprocal } => over(reciprocal, libm::pow(get(x), e)),
+            Machine::Sqrt { x, reciprocal } => over(reciprocal, libm::sqrt(get(x))),
+            Machine::Call(f, x) => match f {
+                Func::Sin => libm::sin(get(x)),
+                Func::Cos => libm::cos(get(x)),
+                Func::Exp => libm::exp(get(x)),
+                Func::Log => libm::log(get(x)),
+                Func::Sqrt => unreachable!("a square root is Machine::Sqrt"),
+            },
+            Machine::SinCos { x, pair, sin } => {
+                let both = libm::sincos(get(x));
+                pairs.insert(pair, both);
+                if sin { both.0 } else { both.1 }
+            }
+            Machine::Half { pair, sin } => {
+                let both = pairs[&pair];
+                if sin { both.0 } else { both.1 }
+            }
+            Machine::Copy(x) => get(x),
+        };
+        match ins.dst() {
+            Slot::Temp(i) => {
+                if temps.len() <= i {
+                    temps.resize(i + 1, 0.0);
+                }
+                temps[i] = value;
+            }
+            Slot::Out(i) => outs[i] = value,
+            Slot::Input(_) | Slot::Const(_) => {
+                unreachable!("instructions write temporaries and outputs")
+            }
+        }
+    }
+    outs
 }
 
 #[cfg(test)]

@@ -69,17 +69,6 @@ impl Func {
             Self::Sqrt => "sqrt",
         }
     }
-
-    /// Its value at x.
-    pub fn apply(self, x: f64) -> f64 {
-        match self {
-            Self::Sin => x.sin(),
-            Self::Cos => x.cos(),
-            Self::Exp => x.exp(),
-            Self::Log => x.ln(),
-            Self::Sqrt => x.sqrt(),
-        }
-    }
 }
 
 /// One instruction.
@@ -265,38 +254,10 @@ impl Program {
         }
     }
 
-    /// Runs the program on `inputs`.
+    /// Runs the program on `inputs`, with the emitted code's arithmetic
+    /// ([`machine::run`]).
     pub fn eval(&self, inputs: &[f64]) -> Vec<f64> {
-        let mut temps: Vec<f64> = Vec::new();
-        let mut outs = vec![0.0; self.outputs];
-        let get = |s: Slot, temps: &Vec<f64>, outs: &Vec<f64>| match s {
-            Slot::Input(i) => inputs[i],
-            Slot::Const(i) => self.consts[i],
-            Slot::Temp(i) => temps[i],
-            Slot::Out(i) => outs[i],
-        };
-        for ins in &self.instrs {
-            let (dst, value) = match ins {
-                Instr::Add(d, s) => (*d, s.iter().map(|&x| get(x, &temps, &outs)).sum()),
-                Instr::Sub(d, [a, b]) => (*d, get(*a, &temps, &outs) - get(*b, &temps, &outs)),
-                Instr::Mul(d, s) => (*d, s.iter().map(|&x| get(x, &temps, &outs)).product()),
-                Instr::Pow(d, s, n) => (*d, get(*s, &temps, &outs).powi(*n as i32)),
-                Instr::Powf(d, s, x) => (*d, powf(get(*s, &temps, &outs), *x)),
-                Instr::Fun(d, f, s) => (*d, f.apply(get(*s, &temps, &outs))),
-                Instr::Assign(d, s) => (*d, get(*s, &temps, &outs)),
-            };
-            match dst {
-                Slot::Temp(i) => {
-                    if temps.len() <= i {
-                        temps.resize(i + 1, 0.0);
-                    }
-                    temps[i] = value;
-                }
-                Slot::Out(i) => outs[i] = value,
-                _ => {}
-            }
-        }
-        outs
+        machine::run(self, inputs)
     }
 
     /// sin and cos of the same value, to be computed together by `sincos` (one
@@ -370,17 +331,6 @@ fn constant(consts: &mut Vec<f64>, x: f64) -> Slot {
         consts.len() - 1
     });
     Slot::Const(k)
-}
-
-/// x^e as the emitted code computes it: a square root where e = ±½.
-pub fn powf(x: f64, e: f64) -> f64 {
-    if e == 0.5 {
-        x.sqrt()
-    } else if e == -0.5 {
-        1.0 / x.sqrt()
-    } else {
-        x.powf(e)
-    }
 }
 
 #[cfg(test)]
