@@ -258,23 +258,24 @@ pub fn compile_dir(models_dir: &Path, out_dir: &Path) -> Result<Vec<Generated>, 
         }
     }
     for (model, generated, failed) in here {
-        let code = derive::derive(&model).and_then(|d| {
-            emittable(&d, Options::default())?;
-            Ok(emit::file(&d, Options::default()))
-        });
-        let written = match (code, failed) {
+        let derived =
+            derive::derive(&model).and_then(|d| emittable(&d, Options::default()).map(|()| d));
+        let written = match (derived, failed) {
             (Err(e), _) => Err(e),
             // The model derives here, yet its own process failed: its code
-            // here could differ from what it would be alone, so it is not
-            // written.
+            // here could differ from what it would be alone, so it is
+            // neither emitted nor written.
             (Ok(_), Some(failure)) => Err(generation_error(
                 &generated.model_file,
                 format!("the process started to generate it alone failed ({failure})"),
             )),
-            (Ok(code), None) => std::fs::write(&generated.rust_file, code).map_err(|e| {
-                let file = generated.rust_file.display();
-                generation_error(&generated.model_file, format!("{file}: {e}"))
-            }),
+            (Ok(d), None) => {
+                let code = emit::file(&d, Options::default());
+                std::fs::write(&generated.rust_file, code).map_err(|e| {
+                    let file = generated.rust_file.display();
+                    generation_error(&generated.model_file, format!("{file}: {e}"))
+                })
+            }
         };
         match written {
             Ok(()) => done.push(generated),
