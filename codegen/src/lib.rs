@@ -8,11 +8,16 @@
 //!    collision map (I − 2P)v, derived exactly in named passes, the paper's
 //!    hypotheses checked, and each emitted function optimised into a
 //!    straight-line [`program::Program`]; the result is plain data;
-//! 3. [`emit`]: Rust tokens for the model, formatted with prettyplease, for
-//!    the [`emit::Options`] asked for (f64 or f32).
+//! 3. [`plan`]: the middle end, done once for both back ends: each function
+//!    split into per-call and once-per-parameter-set work, every
+//!    instruction in machine form ([`program::machine`]), the Taylor
+//!    transforms chosen;
+//! 4. [`emit`]: the plan as Rust tokens, formatted with prettyplease, for the
+//!    [`emit::Options`] asked for (f64 or f32); or [`interpret`]: the plan
+//!    run by a register machine behind the runtime's traits.
 //!
 //! Between the stages: [`quantity`], the table of emitted functions that
-//! stages 2 and 3 share, [`program`] and [`diag`]. No stage imports a later
+//! stages 2 to 4 share, [`program`] and [`diag`]. No stage imports a later
 //! one.
 //!
 //! Front ends: [`compile_dir`] for build scripts (see the workspace's
@@ -27,6 +32,7 @@ pub mod emit;
 pub mod interpret;
 pub mod ir;
 pub mod lock;
+pub mod plan;
 pub mod program;
 pub mod quantity;
 pub mod reference;

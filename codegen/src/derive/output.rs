@@ -4,7 +4,7 @@
 //! come from the same expressions.
 
 use crate::ir::Model;
-use crate::program::{Layout, Program, Transform};
+use crate::program::{Layout, Program};
 use crate::quantity::Quantity;
 
 /// Everything derived for one model.
@@ -174,39 +174,6 @@ impl WallDerivation {
 }
 
 impl Derivation {
-    /// The Taylor transforms of q̈ and of each wall's f, which both back
-    /// ends turn into the model's series (`None` where q̈ is not written
-    /// out). Without constraint rows, the series of q̈ can also be that of
-    /// G and h, or of G and ∂L/∂q, with the solve per order
-    /// ([`Program::taylor_solve`]): the transform of q̈'s own program
-    /// (closed form or elimination) or of one of these systems, whichever
-    /// costs least at the default tolerance's order (q̈'s own on a tie).
-    pub fn series(&self) -> Option<(Transform, Vec<Transform>)> {
-        let (np, nq) = (self.model.params.len(), self.model.coordinates.len());
-        let plain = self
-            .function(Quantity::Accelerations)?
-            .program
-            .taylor(np, nq);
-        let order = dalembert_runtime::simulate::Taylor::default().order();
-        let solved = self.motion_systems.iter().filter_map(|s| {
-            s.program
-                .taylor_solve(np, nq, &s.layout, &s.rhs, s.momentum)
-        });
-        let motion = std::iter::once(plain)
-            .chain(solved)
-            .min_by_key(|t| t.cost(order))
-            .expect("the elimination's transform at least");
-        let walls = self
-            .walls
-            .iter()
-            .map(|w| {
-                w.function(Quantity::Surface)
-                    .map(|f| f.program.taylor(np, nq))
-            })
-            .collect::<Option<Vec<_>>>()?;
-        Some((motion, walls))
-    }
-
     /// The model's function for `q`, if it has one.
     pub fn function(&self, q: Quantity) -> Option<&Function> {
         self.functions.iter().find(|f| f.quantity == q)

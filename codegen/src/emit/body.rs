@@ -7,8 +7,9 @@ use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
 use super::{Ctx, Scalar, ident};
-use crate::program::machine::{Machine, Operand, lower, split};
-use crate::program::{Emit, Program, Slot};
+use crate::plan::Step;
+use crate::program::machine::{Machine, Operand};
+use crate::program::{Program, Slot};
 
 /// `f64` or `f32`.
 pub(super) fn real(d: &Ctx) -> TokenStream {
@@ -44,24 +45,14 @@ pub(super) enum Place {
 }
 
 /// Statements computing `o0, o1, …` from the program, each instruction as
-/// `plan` says for `place`: computed, stored as `pre[k]`, read from
-/// `self.pre[k]`, split at its leading operands, or left out.
-pub(super) fn statements(d: &Ctx, p: &Program, plan: &[Emit], place: Place) -> TokenStream {
-    // The operands each instruction reads here.
-    let reads = |i: usize| -> &[Slot] {
-        let s = p.instrs[i].sources();
-        match (plan[i], place) {
-            (Emit::Compute | Emit::Store(_), _) => s,
-            (Emit::Leading(_, n), Place::Once) => &s[..n],
-            (Emit::Leading(_, n), Place::Call) => &s[n..],
-            (Emit::Skip | Emit::Load(_), _) => &[],
-        }
-    };
+/// its [`Step`] in `place` says: computed, stored as `pre[k]`, read from
+/// `self.pre[k]`, a kept value computed, or left out.
+pub(super) fn statements(d: &Ctx, p: &Program, steps: &[Step], place: Place) -> TokenStream {
     let mut used = vec![false; p.inputs];
-    for i in 0..p.instrs.len() {
-        for s in reads(i) {
+    for m in steps.iter().filter_map(Step::machine) {
+        for s in m.slots() {
             if let Slot::Input(k) = s {
-                used[*k] = true;
+                used[k] = true;
             }
         }
     }
@@ -75,33 +66,24 @@ pub(super) fn statements(d: &Ctx, p: &Program, plan: &[Emit], place: Place) -> T
         let value = input_value(d, i, &params);
         quote! { let #name: #real = #value; }
     });
-    // Each instruction's machine form where it is computed here (sin and
-    // cos of a value share one sincos where both are).
-    let computed = |i: usize| matches!(plan[i], Emit::Compute | Emit::Store(_));
-    let machine = lower(p, computed);
-    let stmts = p.instrs.iter().enumerate().map(|(i, ins)| {
+    let stmts = p.instrs.iter().zip(steps).map(|(ins, step)| {
         let dst = ins.dst();
-        let slot_dst = slot(d, p, dst);
-        match (plan[i], place) {
-            (Emit::Skip, _) => TokenStream::new(),
-            (Emit::Compute, _) => statement(d, p, dst, machine[i].as_ref().unwrap()),
-            (Emit::Store(k), _) => {
-                let computation = statement(d, p, dst, machine[i].as_ref().unwrap());
-                let k = Literal::usize_unsuffixed(k);
-                quote! { #computation pre[#k] = #slot_dst; }
+        match step {
+            Step::Skip => TokenStream::new(),
+            Step::Compute(m) => statement(d, p, dst, m),
+            Step::Store(m, k) => {
+                let computation = statement(d, p, dst, m);
+                let (dst, k) = (slot(d, p, dst), Literal::usize_unsuffixed(*k));
+                quote! { #computation pre[#k] = #dst; }
             }
-            (Emit::Load(k), _) => {
-                let k = Literal::usize_unsuffixed(k);
-                quote! { let #slot_dst: #real = self.pre[#k]; }
+            Step::Load(k) => {
+                let (dst, k) = (slot(d, p, dst), Literal::usize_unsuffixed(*k));
+                quote! { let #dst: #real = self.pre[#k]; }
             }
-            (Emit::Leading(k, n), Place::Once) => {
-                let value = expression(d, p, &split(p, ins, None, &ins.sources()[..n]));
-                let k = Literal::usize_unsuffixed(k);
+            Step::Keep(m, k) => {
+                let value = expression(d, p, m);
+                let k = Literal::usize_unsuffixed(*k);
                 quote! { pre[#k] = #value; }
-            }
-            (Emit::Leading(k, n), Place::Call) => {
-                let value = expression(d, p, &split(p, ins, Some(k), &ins.sources()[n..]));
-                quote! { let #slot_dst: #real = #value; }
             }
         }
     });

@@ -16,8 +16,12 @@ use crate::quantity::{Inputs, Shape};
 pub(super) fn inherent_impl(d: &Ctx) -> TokenStream {
     let ty = format_ident!("{}", d.model.type_name());
     let (q, n) = dims(d);
-    let model_fns = d.functions.iter().map(|f| emit_function(d, f, None));
-    let walls = d.walls.iter().map(|w| wall_fns(d, w));
+    let model_fns = d
+        .derivation
+        .functions
+        .iter()
+        .map(|f| emit_function(d, f, None));
+    let walls = d.derivation.walls.iter().map(|w| wall_fns(d, w));
     let qn = Literal::usize_unsuffixed(q);
     let nn = Literal::usize_unsuffixed(n);
     let init_q = d.model.initial[..q].iter().map(|x| lit(d, *x));
@@ -27,7 +31,11 @@ pub(super) fn inherent_impl(d: &Ctx) -> TokenStream {
     let coords = &d.model.coordinates;
     let vels = &d.model.velocities;
     let pnames = d.model.params.iter().map(|p| &p.name);
-    let variants = d.walls.iter().map(|w| format_ident!("{}", camel(&w.name)));
+    let variants = d
+        .derivation
+        .walls
+        .iter()
+        .map(|w| format_ident!("{}", camel(&w.name)));
     let precompute = precompute(d);
     let series = super::taylor::functions(d);
     quote! {
@@ -77,13 +85,12 @@ pub(super) fn inherent_impl(d: &Ctx) -> TokenStream {
 /// The once-per-parameter-set block: each function's parameter-only work,
 /// storing the values its per-call code reads.
 fn precompute(d: &Ctx) -> TokenStream {
-    let blocks = d.named_functions().into_iter().filter_map(|(name, f)| {
-        let split = d.split(&name);
-        let stmts = body::statements(d, &f.program, &split.once, Place::Once);
-        (split.stored > 0).then(|| quote! { { #stmts } })
+    let blocks = d.plan.functions.iter().filter_map(|f| {
+        let stmts = body::statements(d, &f.function.program, &f.once, Place::Once);
+        (f.split.stored > 0).then(|| quote! { { #stmts } })
     });
     let real = real(d);
-    let k = Literal::usize_unsuffixed(d.stored);
+    let k = Literal::usize_unsuffixed(d.plan.stored);
     quote! {
         /// The parameter-only values the functions read, from `params`.
         #[allow(unused_variables, unused_mut, clippy::approx_constant)]
@@ -232,8 +239,8 @@ fn function(
 ) -> TokenStream {
     let f = ident(name);
     let args = args(d, inputs);
-    let plan = &d.split(name).call;
-    let body = body::statements(d, p, plan, Place::Call);
+    let steps = &d.plan.function(name).call;
+    let body = body::statements(d, p, steps, Place::Call);
     let doc = doc_attr(doc);
     quote! {
         #doc

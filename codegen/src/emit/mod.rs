@@ -1,4 +1,4 @@
-//! Stage 3: a [`Derivation`] to Rust source.
+//! Stage 4: a [`Plan`] to Rust source.
 //!
 //! One small function per emitted piece; the result is formatted with
 //! prettyplease. Emitted code is `no_std`, allocation-free and panic-free on
@@ -17,16 +17,15 @@ mod taylor;
 mod text;
 mod traits;
 
-use std::collections::HashMap;
-use std::ops::Deref;
-
 use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::{format_ident, quote};
 
 use crate::Generated;
 use crate::derive::Derivation;
+use crate::ir::Model;
 use crate::ir::camel;
-use crate::program::{OpCount, Split, Transform};
+use crate::plan::{Plan, Taylor};
+use crate::program::{OpCount, Transform};
 
 use body::{lit, real};
 
@@ -49,69 +48,36 @@ pub struct Options {
     pub scalar: Scalar,
 }
 
-/// A derivation together with the emission options and the split of each
-/// function into per-call and once-per-parameter-set work: what every
-/// emitting function sees (it reads as the derivation).
+/// What every emitting function sees: the model, the derivation, its plan
+/// and the emission options.
 struct Ctx<'a> {
-    d: &'a Derivation,
+    model: &'a Model,
+    derivation: &'a Derivation,
+    plan: &'a Plan<'a>,
     scalar: Scalar,
-    /// Each emitted function's split, by its name in the generated code.
-    splits: HashMap<String, Split>,
-    /// Precomputed values in all.
-    stored: usize,
-    /// The Taylor transforms of q̈ and of each wall's f
-    /// ([`Derivation::series`], worked out once; `None` for f32).
-    series: Option<(Transform, Vec<Transform>)>,
 }
 
-impl<'a> Ctx<'a> {
-    fn new(d: &'a Derivation, scalar: Scalar) -> Self {
-        let params = d.model.params.len();
-        let mut splits = HashMap::new();
-        let mut stored = 0;
-        for (name, f) in d.named_functions() {
-            let split = f.program.split(params, stored);
-            stored += split.stored;
-            splits.insert(name, split);
-        }
-        let series = (scalar == Scalar::F64).then(|| d.series()).flatten();
-        Self {
-            d,
-            scalar,
-            splits,
-            stored,
-            series,
-        }
-    }
-
-    /// The split of the function named `name` in the generated code.
-    fn split(&self, name: &str) -> &Split {
-        &self.splits[name]
-    }
-
-    /// Operations per call and once per parameter set, by function.
-    fn op_counts(&self) -> Vec<(String, OpCount, OpCount)> {
-        self.d
-            .named_functions()
-            .into_iter()
-            .map(|(name, f)| {
-                let (call, once) = self.split(&name).op_counts(&f.program);
-                (name, call, once)
-            })
-            .collect()
-    }
-}
-
-impl Deref for Ctx<'_> {
-    type Target = Derivation;
-    fn deref(&self) -> &Derivation {
-        self.d
+impl Ctx<'_> {
+    /// The Taylor transforms of q̈ and of each wall's f (`None` for f32 or
+    /// where q̈ is not written out: then the model has no series at all).
+    fn series(&self) -> Option<(&Transform, &[Transform])> {
+        (self.plan.series.as_ref()).map(|(m, w)| (m, w.as_slice()))
     }
 }
 
 /// The formatted Rust file for one model.
 pub fn file(d: &Derivation, options: Options) -> String {
-    let d = &Ctx::new(d, options.scalar);
+    let taylor = match options.scalar {
+        Scalar::F64 => Taylor::Include,
+        Scalar::F32 => Taylor::Omit,
+    };
+    let plan = Plan::new(d, taylor);
+    let d = &Ctx {
+        model: &d.model,
+        derivation: d,
+        plan: &plan,
+        scalar: options.scalar,
+    };
     let tokens = model_tokens(d);
     let file: syn::File = match syn::parse2(tokens) {
         Ok(f) => f,
@@ -143,11 +109,11 @@ fn header(d: &Ctx) -> String {
         "//\n// Operation counts per call ({}):\n",
         real(d)
     ));
-    let counts = d.op_counts();
+    let counts = d.plan.op_counts();
     for (name, call, _) in &counts {
         h.push_str(&format!("//   {name:<28} {call}\n"));
     }
-    for w in d.walls.iter().filter(|w| w.structured()) {
+    for w in d.derivation.walls.iter().filter(|w| w.structured()) {
         let what = match w.collision {
             Some(_) => format!("{}_projector", w.name),
             None => format!("{}_projector, _collide", w.name),
@@ -156,7 +122,7 @@ fn header(d: &Ctx) -> String {
             "//   {what:<28} structured: solved at run time from G and B\n"
         ));
     }
-    if let Some((motion, walls)) = taylor::transforms(d) {
+    if let Some((motion, walls)) = d.series() {
         h.push_str("//\n// Taylor series, per order (series operations, of them convolutions):\n");
         let work = motion.work();
         let (ops, loops) = (work.operations, work.convolutions);
@@ -164,7 +130,7 @@ fn header(d: &Ctx) -> String {
             "//   {:<28} {ops} ops, {loops} convolutions\n",
             "motion_series"
         ));
-        for (w, t) in d.walls.iter().zip(walls) {
+        for (w, t) in d.derivation.walls.iter().zip(walls) {
             let work = t.work();
             let (ops, loops) = (work.operations, work.convolutions);
             let name = format!("{}_surface_series", w.name);
@@ -178,9 +144,10 @@ fn header(d: &Ctx) -> String {
         .fold(OpCount::default(), |sum, (_, _, once)| sum + *once);
     h.push_str(&format!(
         "//\n// Parameter-only work, done once when the parameters are set ({} values kept):\n//   {:<28} {once}\n",
-        d.stored, "all functions"
+        d.plan.stored, "all functions"
     ));
     let chosen: Vec<_> = d
+        .derivation
         .walls
         .iter()
         .filter_map(|w| {
@@ -222,7 +189,7 @@ fn model_tokens(d: &Ctx) -> TokenStream {
         Scalar::F32 => TokenStream::new(),
     };
     let real = real(d);
-    let k = Literal::usize_unsuffixed(d.stored);
+    let k = Literal::usize_unsuffixed(d.plan.stored);
     quote! {
         #params
         #walls
@@ -278,11 +245,13 @@ fn params_struct(d: &Ctx) -> TokenStream {
 }
 fn wall_enum(d: &Ctx) -> TokenStream {
     let variants: Vec<Ident> = d
+        .derivation
         .walls
         .iter()
         .map(|w| format_ident!("{}", camel(&w.name)))
         .collect();
     let docs: Vec<TokenStream> = d
+        .derivation
         .walls
         .iter()
         .map(|w| doc_attr(if w.doc.is_empty() { &w.name } else { &w.doc }))

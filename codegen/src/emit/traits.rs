@@ -19,11 +19,12 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
     let ql = Literal::usize_unsuffixed(q);
     let nl = Literal::usize_unsuffixed(n);
     let variants: Vec<Ident> = d
+        .derivation
         .walls
         .iter()
         .map(|w| format_ident!("{}", camel(&w.name)))
         .collect();
-    let wall_names: Vec<&String> = d.walls.iter().map(|w| &w.name).collect();
+    let wall_names: Vec<&String> = d.derivation.walls.iter().map(|w| &w.name).collect();
     let pidents: Vec<Ident> = d.model.params.iter().map(|p| ident(&p.name)).collect();
     let pidx: Vec<Literal> = (0..pidents.len()).map(Literal::usize_unsuffixed).collect();
     let methods = |c: Capability| {
@@ -69,7 +70,7 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
         return model_impl;
     }
     let (dynamics, surfaces) = (methods(Capability::Dynamics), methods(Capability::Surfaces));
-    let (motion_series, surface_series) = match super::taylor::transforms(d) {
+    let (motion_series, surface_series) = match d.series() {
         Some((motion, walls)) => {
             let work = |w: Work| {
                 let (o, c) = (
@@ -80,7 +81,7 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
             };
             let motion_work = work(motion.work());
             let walls_work = work(walls.iter().map(Transform::work).sum());
-            let arms = d.walls.iter().zip(&variants).map(|(w, v)| {
+            let arms = d.derivation.walls.iter().zip(&variants).map(|(w, v)| {
                 let f = format_ident!("{}_surface_series", w.name);
                 quote! { Wall::#v => self.#f(series, scratch, out) }
             });
@@ -166,11 +167,11 @@ fn forward(d: &Ctx, spec: &Spec, variants: &[Ident]) -> Option<TokenStream> {
         Forward::Some => quote! { Option<#ty> },
     };
     let (params, value) = if !spec.capability.per_wall() {
-        d.function(spec.quantity)?;
+        d.derivation.function(spec.quantity)?;
         let f = format_ident!("{}", spec.name);
         (params, wrapped(quote! { self.#f(#args) }))
     } else {
-        let arms = d.walls.iter().zip(variants).map(|(w, v)| {
+        let arms = d.derivation.walls.iter().zip(variants).map(|(w, v)| {
             let f = format_ident!("{}_{}", w.name, spec.name);
             let value = wrapped(quote! { self.#f(#args) });
             quote! { Wall::#v => #value }

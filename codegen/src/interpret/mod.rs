@@ -19,6 +19,7 @@ use dalembert_runtime::{__private, Dynamics, Model, Rows, Surfaces, Values, Wall
 
 use crate::derive::{Derivation, Function};
 use crate::ir::Kind;
+use crate::plan::{Plan, Taylor};
 use crate::program::{Evaluation, Transform};
 use crate::quantity::Quantity;
 use tape::Tape;
@@ -238,7 +239,8 @@ impl<const N: usize> Interpreted<N> {
                 collide: find(&w.functions, Quantity::Collide),
             });
         }
-        let series = d.series().map(|t| SeriesPrograms::new(t, &values));
+        let series =
+            (Plan::new(d, Taylor::Include).series).map(|t| SeriesPrograms::new(t, &values));
         Ok(Self {
             series,
             name: leak_names(std::iter::once(m.name.clone()))[0],

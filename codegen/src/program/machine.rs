@@ -87,6 +87,31 @@ pub enum Machine {
     Copy(Slot),
 }
 
+impl Machine {
+    /// The slots it reads (a pair's second half reads none: its first did).
+    pub fn slots(&self) -> Vec<Slot> {
+        let operands = |xs: &[Operand]| {
+            (xs.iter())
+                .filter_map(|o| match o {
+                    Operand::Slot(s) => Some(*s),
+                    Operand::Kept(_) => None,
+                })
+                .collect()
+        };
+        match self {
+            Self::Sum(xs) | Self::Product { factors: xs, .. } => operands(xs),
+            Self::Difference(a, b) => vec![*a, *b],
+            Self::Number(_) | Self::Half { .. } => vec![],
+            Self::Power { x, .. }
+            | Self::Pow { x, .. }
+            | Self::Sqrt { x, .. }
+            | Self::Call(_, x)
+            | Self::SinCos { x, .. }
+            | Self::Copy(x) => vec![*x],
+        }
+    }
+}
+
 /// Each instruction of `p` in machine form, `None` where `computed` says it
 /// is not computed here; sin and cos of one value are a pair where both are
 /// computed.

@@ -31,12 +31,6 @@ use pairs::Plan;
 use room::prelude;
 pub(super) use room::scratch_struct;
 
-/// The model's transforms: q̈'s, then each wall's f's (`None` for f32 or
-/// where q̈ is not written out: then the model has no series at all).
-pub(super) fn transforms<'a>(d: &'a Ctx) -> Option<(&'a Transform, &'a [Transform])> {
-    d.series.as_ref().map(|(m, w)| (m, w.as_slice()))
-}
-
 /// The lints the series functions' shape sets off: unused bindings of
 /// the time-constant values, literal constants near π, loops over orders
 /// that index several arrays, copies of coefficients, and `&x` of an
@@ -69,7 +63,7 @@ fn motion_signature(n: &Literal) -> TokenStream {
 
 /// `motion_series` and every `{wall}_surface_series`.
 pub(super) fn functions(d: &Ctx) -> TokenStream {
-    let Some((motion, walls)) = transforms(d) else {
+    let Some((motion, walls)) = d.series() else {
         return TokenStream::new();
     };
     let n = Literal::usize_unsuffixed(d.model.velocities.len());
@@ -126,7 +120,7 @@ pub(super) fn functions(d: &Ctx) -> TokenStream {
 
 /// Every `{wall}_surface_series`.
 fn wall_functions(d: &Ctx, walls: &[Transform], n: &Literal) -> TokenStream {
-    let wall_fns = d.walls.iter().zip(walls).map(|(w, t)| {
+    let wall_fns = d.derivation.walls.iter().zip(walls).map(|(w, t)| {
         let name = format_ident!("{}_surface_series", w.name);
         let doc = format!(
             " Wall `{}`: the Taylor coefficients of f(q(t)) along `s`, orders 0 to `s.order`, in `scratch`'s room.",

@@ -8,15 +8,15 @@ use quote::{format_ident, quote};
 use super::super::Ctx;
 use super::super::body::{self, Place};
 use super::pairs::{self, Plan};
-use super::transforms;
-use crate::program::{Emit, Op, Slot, Transform};
+use crate::plan::computed;
+use crate::program::{Op, Slot, Transform};
 
 /// `SeriesScratch`: room for the intermediate series of every function
 /// above, one pool they share (they never run at once), as long as the
 /// longest list of [`arrays`], and one pool of lanes (pairs of series side
 /// by side, [`pairs`]) as long as the most any of them uses.
 pub(in crate::emit) fn scratch_struct(d: &Ctx) -> TokenStream {
-    let Some((motion, walls)) = transforms(d) else {
+    let Some((motion, walls)) = d.series() else {
         return TokenStream::new();
     };
     let most = |count: &dyn Fn(&Transform) -> usize| {
@@ -90,8 +90,7 @@ fn arrays(t: &Transform) -> Vec<proc_macro2::Ident> {
 /// The time-constant values, the intermediate series (single coefficients
 /// on the stack, whole arrays in `scratch`) and the lanes of `plan`.
 pub(super) fn prelude(d: &Ctx, t: &Transform, plan: &Plan) -> TokenStream {
-    let compute = vec![Emit::Compute; t.numbers.instrs.len()];
-    let numbers = body::statements(d, &t.numbers, &compute, Place::Call);
+    let numbers = body::statements(d, &t.numbers, &computed(&t.numbers), Place::Call);
     // Series operations read parameters directly too (a product with m);
     // those the numbers read are bound by their statements.
     let read: Vec<Slot> = t
