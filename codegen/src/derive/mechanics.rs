@@ -4,6 +4,8 @@
 //! vᵀ∇²f v and contact rows. Then, after lowering (pass 3), G exactly, the
 //! symbolic-or-structured choice, and q̈ in closed form where G⁻¹ is exact.
 
+use std::ops::Range;
+
 use symbolica::prelude::*;
 
 use super::lower::Lowering;
@@ -105,7 +107,12 @@ pub fn raw(sym: &Symbols, cx: &mut Collector) -> Result<Raw, Reported> {
     for i in 0..n {
         let ti = t.derivative(sym.vels[i]);
         for j in 0..n {
-            g[i][j] = ti.derivative(sym.vels[j]).expand();
+            g[i][j] = budget::expand(
+                &ti.derivative(sym.vels[j]),
+                cx,
+                &m.kinetic_energy.span,
+                "the kinetic energy",
+            )?;
         }
     }
     checks::kinetic_energy_quadratic(sym, cx, &t, &g);
@@ -166,11 +173,12 @@ fn raw_wall(sym: &Symbols, cx: &mut Collector, w: &Wall) -> Result<RawWall, Repo
                 wall: w.name.clone(),
                 velocity: v,
             });
+            let what = format!("wall `{}`'s surface", w.name);
             let mut row = vec![Atom::num(0); n];
             for (k, q) in sym.coords.iter().enumerate() {
-                row[k] = f.derivative(*q).expand();
+                row[k] = budget::expand(&f.derivative(*q), cx, &e.span, &what)?;
             }
-            let hessian = hessian_form(sym, &row);
+            let hessian = hessian_form(sym, &row, cx, &e.span, &what)?;
             (f, row, hessian)
         }
         Kind::Instantaneous => {
@@ -248,17 +256,29 @@ fn equations_of_motion(
     (forcing, drift)
 }
 
-/// vᵀ∇²f(q)v from the normal df = `row`: Σₖ (Σᵢ ∂ₖ∂ᵢf vᵢ) vₖ.
-fn hessian_form(sym: &Symbols, row: &[Atom]) -> Atom {
+/// vᵀ∇²f(q)v from the normal df = `row`: Σₖ (Σᵢ ∂ₖ∂ᵢf vᵢ) vₖ, expanded
+/// within the budget (checked after each second derivative, so that a form
+/// too large stops at its first entries, `what` at `span` named).
+fn hessian_form(
+    sym: &Symbols,
+    row: &[Atom],
+    cx: &mut Collector,
+    span: &Range<usize>,
+    what: &str,
+) -> Result<Atom, Reported> {
     let mut form = Atom::num(0);
+    let mut bound = 0.0;
     for (k, entry) in row.iter().enumerate() {
         let mut rate = Atom::num(0);
         for (i, q) in sym.coords.iter().enumerate() {
-            rate += entry.derivative(*q) * sym.vel(i);
+            let d = entry.derivative(*q);
+            bound += budget::expansion_terms(&d);
+            budget::within(bound, cx, span, what)?;
+            rate += d * sym.vel(i);
         }
         form += rate * sym.vel(k);
     }
-    form.expand()
+    Ok(form.expand())
 }
 
 /// G and A as exact rational functions, and how P will be evaluated.
