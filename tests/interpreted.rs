@@ -118,6 +118,17 @@ fn same_functions<M: Surfaces<N>, I: Surfaces<N>, const N: usize>(
     if let (Some(ac), Some(ai)) = (ac, ai) {
         agree(&format!("{name} q̈"), &ac, &ai);
     }
+    // Tangents along (v, q): any direction will do.
+    let tc = c.accelerations_tangent(q, v, v, q);
+    let ti = i.accelerations_tangent(q, v, v, q);
+    assert_eq!(
+        tc.is_some(),
+        ti.is_some(),
+        "{name}: q̈'s tangent in one only"
+    );
+    if let (Some(tc), Some(ti)) = (tc, ti) {
+        agree(&format!("{name} q̈ tangent"), &tc.1, &ti.1);
+    }
     agree(
         &format!("{name} initial q"),
         &c.initial_coordinates(),
@@ -171,6 +182,14 @@ fn same_functions<M: Surfaces<N>, I: Surfaces<N>, const N: usize>(
             &c.collide(wc, q, v),
             &i.collide(wi, q, v),
         );
+        let (tc, ti) = (
+            c.collide_tangent(wc, q, v, v, q),
+            i.collide_tangent(wi, q, v, v, q),
+        );
+        assert_eq!(tc.is_some(), ti.is_some(), "{w}: tangent in one only");
+        if let (Some(tc), Some(ti)) = (tc, ti) {
+            agree(&format!("{w} collide tangent"), &tc.1, &ti.1);
+        }
         agree(&format!("{w} normal"), &c.normal(wc, q), &i.normal(wi, q));
         let (nc, ni) = (c.normal_velocity(wc, q, v), i.normal_velocity(wi, q, v));
         agree(&format!("{w} normal velocity"), &[nc], &[ni]);

@@ -90,3 +90,49 @@ fn single_precision_is_as_accurate_as_f32_allows() {
     );
     assert!(worst[0] < 1e-5 && worst[1] < 1e-5, "{worst:?}");
 }
+
+/// The single-precision tangents of §3.1 in Euler angles (q̈'s and the
+/// collision map's) against the f64 ones, relative to the size of the
+/// f64 derivative.
+#[test]
+fn single_precision_tangents_follow_the_f64_ones() {
+    use dalembert::models::ball_wall_euler::Wall;
+    let mut s = 11;
+    let mut worst = [0.0f64; 2];
+    let (m, single) = (
+        BallWallEuler::default(),
+        single::ball_wall_euler::BallWallEuler::default(),
+    );
+    let f32s = |x: &[f64; 5]| x.map(|x| x as f32);
+    for _ in 0..10_000 {
+        let mut q: [f64; 5] = std::array::from_fn(|_| -3.0 + 6.0 * lcg(&mut s));
+        q[3] = 0.3 + 2.5 * lcg(&mut s); // away from θ = 0, π
+        let [v, dq, dv]: [[f64; 5]; 3] =
+            std::array::from_fn(|_| std::array::from_fn(|_| -3.0 + 6.0 * lcg(&mut s)));
+        let pairs = [
+            (
+                m.accelerations_tangent(&q, &v, &dq, &dv).1,
+                single
+                    .accelerations_tangent(&f32s(&q), &f32s(&v), &f32s(&dq), &f32s(&dv))
+                    .1,
+            ),
+            (
+                m.collide_tangent(Wall::Wall, &q, &v, &dq, &dv).unwrap().1,
+                single
+                    .wall_collide_tangent(&f32s(&q), &f32s(&v), &f32s(&dq), &f32s(&dv))
+                    .1,
+            ),
+        ];
+        for (k, (exact, single)) in pairs.iter().enumerate() {
+            let size = exact.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+            for (a, b) in exact.iter().zip(single) {
+                worst[k] = worst[k].max((a - *b as f64).abs() / size);
+            }
+        }
+    }
+    eprintln!(
+        "f32 tangents against f64, largest error relative to their size: q̈ {:.1e}, collision map {:.1e}",
+        worst[0], worst[1]
+    );
+    assert!(worst[0] < 5e-5 && worst[1] < 5e-5, "{worst:?}");
+}

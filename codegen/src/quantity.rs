@@ -41,6 +41,10 @@ pub enum Quantity {
     Projector,
     /// A wall's (I − 2P)v, in closed form.
     Collide,
+    /// q̈ and its derivative along a direction (δq, δv) of the phase.
+    AccelerationsTangent,
+    /// A wall's (I − 2P)v and its derivative along a direction (δq, δv).
+    CollideTangent,
     /// The starting state of the file's `[initial]`, at the parameters in
     /// use.
     InitialState,
@@ -55,6 +59,8 @@ pub enum Inputs {
     Coordinates,
     /// The coordinates q and the velocities v.
     Phase,
+    /// The coordinates q, the velocities v, and a direction (δq, δv).
+    Tangent,
 }
 
 /// What an emitted function returns.
@@ -72,6 +78,9 @@ pub enum Shape {
     Values,
     /// A state: the coordinates, then the velocities.
     State,
+    /// N numbers and their derivatives along a direction: the program's
+    /// outputs are the values, then the derivatives (each padded to N).
+    Tangent,
 }
 
 /// How the `Model` trait method returns the inherent function's value.
@@ -215,6 +224,15 @@ pub const TABLE: &[Spec] = &[
         method: Some(("closed_form_accelerations", Forward::Some)),
     },
     Spec {
+        quantity: Quantity::AccelerationsTangent,
+        name: "accelerations_tangent",
+        inputs: Inputs::Tangent,
+        shape: Shape::Tangent,
+        doc: "q̈ as `accelerations` computes it, and its derivative along (δq, δv): (q̈, ∂q̈/∂q δq + ∂q̈/∂v δv), by forward differentiation of the same program. A column of the Jacobian for a unit direction.",
+        capability: Capability::Dynamics,
+        method: Some(("accelerations_tangent", Forward::Some)),
+    },
+    Spec {
         quantity: Quantity::InitialState,
         name: "initial_state",
         inputs: Inputs::Parameters,
@@ -285,6 +303,15 @@ pub const TABLE: &[Spec] = &[
         doc: "Wall `{wall}`: the collision map v⁺ = (I − 2P)v⁻ for admissible v⁻ (A v⁻ = 0; elsewhere it may differ from (I − 2P)v⁻, see the header's solves).",
         capability: Capability::Walls,
         method: Some(("collide", Forward::Plain)),
+    },
+    Spec {
+        quantity: Quantity::CollideTangent,
+        name: "collide_tangent",
+        inputs: Inputs::Tangent,
+        shape: Shape::Tangent,
+        doc: "Wall `{wall}`: v⁺ as `collide` computes it, and its derivative along (δq, δv⁻): (v⁺, ∂v⁺/∂q δq + ∂v⁺/∂v⁻ δv⁻), by forward differentiation of the same program.",
+        capability: Capability::Walls,
+        method: Some(("collide_tangent", Forward::Some)),
     },
 ];
 

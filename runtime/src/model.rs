@@ -103,6 +103,51 @@ pub trait Walls<const Q: usize, const N: usize>: Model<Q, N> {
     fn normal_velocity(&self, wall: Self::Wall, q: &[f64; Q], v: &[f64; N]) -> f64 {
         linalg::dot(&self.normal(wall, q), v)
     }
+
+    /// The collision map and its derivative along a direction (δq, δv⁻):
+    /// (v⁺, ∂v⁺/∂q δq + ∂v⁺/∂v⁻ δv⁻), for admissible v⁻ as in
+    /// [`Walls::collide`]. Generated models differentiate the map's own
+    /// program, so the derivative is that of the numbers `collide` returns;
+    /// `None` (the default, and a generated wall whose P is solved at run
+    /// time) means the model has no derivative of it.
+    fn collide_tangent(
+        &self,
+        wall: Self::Wall,
+        q: &[f64; Q],
+        v: &[f64; N],
+        dq: &[f64; Q],
+        dv: &[f64; N],
+    ) -> Option<([f64; N], [f64; N])> {
+        let _ = (wall, q, v, dq, dv);
+        None
+    }
+
+    /// The Jacobian of the collision map at (q, v⁻): (∂v⁺/∂q, ∂v⁺/∂v⁻),
+    /// entry `[i][j]` the derivative of v⁺ᵢ by qⱼ (resp. v⁻ⱼ), from Q + N
+    /// calls of [`Walls::collide_tangent`]; `None` where that is.
+    #[allow(clippy::type_complexity)]
+    fn collide_jacobian(
+        &self,
+        wall: Self::Wall,
+        q: &[f64; Q],
+        v: &[f64; N],
+    ) -> Option<([[f64; Q]; N], [[f64; N]; N])> {
+        let mut by_q = [[0.0; Q]; N];
+        let mut by_v = [[0.0; N]; N];
+        for j in 0..Q {
+            let mut dq = [0.0; Q];
+            dq[j] = 1.0;
+            let (_, column) = self.collide_tangent(wall, q, v, &dq, &[0.0; N])?;
+            (0..N).for_each(|i| by_q[i][j] = column[i]);
+        }
+        for j in 0..N {
+            let mut dv = [0.0; N];
+            dv[j] = 1.0;
+            let (_, column) = self.collide_tangent(wall, q, v, &[0.0; Q], &dv)?;
+            (0..N).for_each(|i| by_v[i][j] = column[i]);
+        }
+        Some((by_q, by_v))
+    }
 }
 
 /// The motion between collisions of a model with coordinates: the
@@ -142,6 +187,45 @@ pub trait Dynamics<const N: usize>: Model<N, N> {
     fn closed_form_accelerations(&self, q: &[f64; N], v: &[f64; N]) -> Option<[f64; N]> {
         let _ = (q, v);
         None
+    }
+
+    /// [`Dynamics::closed_form_accelerations`] and its derivative along a
+    /// direction (δq, δv): (q̈, ∂q̈/∂q δq + ∂q̈/∂v δv). Generated models
+    /// differentiate q̈'s own program forward (exact up to rounding, no
+    /// finite differences); `None` (the default) where the model writes no
+    /// q̈ out.
+    fn accelerations_tangent(
+        &self,
+        q: &[f64; N],
+        v: &[f64; N],
+        dq: &[f64; N],
+        dv: &[f64; N],
+    ) -> Option<([f64; N], [f64; N])> {
+        let _ = (q, v, dq, dv);
+        None
+    }
+
+    /// The Jacobian of q̈ at (q, v): (∂q̈/∂q, ∂q̈/∂v), entry `[i][j]` the
+    /// derivative of q̈ᵢ by qⱼ (resp. vⱼ), from 2N calls of
+    /// [`Dynamics::accelerations_tangent`]; `None` where that is. The
+    /// derivative by q is taken with v held fixed, off the constraint
+    /// manifold too.
+    #[allow(clippy::type_complexity)]
+    fn accelerations_jacobian(
+        &self,
+        q: &[f64; N],
+        v: &[f64; N],
+    ) -> Option<([[f64; N]; N], [[f64; N]; N])> {
+        let mut by_q = [[0.0; N]; N];
+        let mut by_v = [[0.0; N]; N];
+        for j in 0..2 * N {
+            let mut direction = [[0.0; N]; 2];
+            direction[j / N][j % N] = 1.0;
+            let (_, column) = self.accelerations_tangent(q, v, &direction[0], &direction[1])?;
+            let target = if j < N { &mut by_q } else { &mut by_v };
+            (0..N).for_each(|i| target[i][j % N] = column[i]);
+        }
+        Some((by_q, by_v))
     }
 
     /// Room for the intermediate coefficients of the model's series

@@ -12,7 +12,9 @@
 //! 5. [`evaluate`]: each emitted function to an optimised straight-line
 //!    program (symbolica's evaluator: common subexpressions, Horner), also
 //!    with its parameter-only coefficients named first ([`coefficients`]),
-//!    the cheaper of the two kept.
+//!    the cheaper of the two kept;
+//! 6. [`tangents`]: q̈'s and each collision map's program differentiated
+//!    forward ([`Program::tangent`], no symbolica).
 //!
 //! The result is plain data ([`Derivation`]); [`inspect`] has symbolic
 //! helpers for front ends and tests.
@@ -144,7 +146,9 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
         motion_systems.extend(m);
     }
     functions.push(initial_state(&sym, &compile, cx)?);
-    let functions = functions.into_iter().flatten().collect();
+    let mut functions = functions.into_iter().flatten().collect();
+    let mut walls = walls;
+    tangents(&mut functions, &mut walls, sym.params.len());
     Ok(Derivation {
         model: model.clone(),
         mass_matrix: strings(&exact.g),
@@ -155,6 +159,37 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
         functions,
         motion_systems,
     })
+}
+
+/// Pass 6: the tangent functions, q̈'s and each collision map's program
+/// differentiated forward along the phase (the inputs after the
+/// `params` parameters), each placed after the function it differentiates.
+fn tangents(functions: &mut Vec<Function>, walls: &mut [WallDerivation], params: usize) {
+    let tangent = |list: &mut Vec<Function>, of: Quantity, quantity: Quantity| {
+        if let Some(i) = list.iter().position(|f| f.quantity == of) {
+            let program = list[i].program.tangent(params);
+            list.insert(
+                i + 1,
+                Function {
+                    quantity,
+                    program,
+                    rows: 0,
+                },
+            );
+        }
+    };
+    tangent(
+        functions,
+        Quantity::Accelerations,
+        Quantity::AccelerationsTangent,
+    );
+    for w in walls {
+        tangent(
+            &mut w.functions,
+            Quantity::Collide,
+            Quantity::CollideTangent,
+        );
+    }
 }
 
 /// The `[initial]` state as a function of the parameters, so that it

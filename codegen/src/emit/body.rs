@@ -194,8 +194,15 @@ fn input_value(d: &Ctx, i: usize, params: &TokenStream) -> TokenStream {
         let k = Literal::usize_unsuffixed(i - np);
         quote! { q[#k] }
     } else {
-        let k = Literal::usize_unsuffixed(i - np - nq);
-        quote! { v[#k] }
+        // After the phase (q, v), a tangent function's direction (dq, dv).
+        let nv = d.model.velocities.len();
+        let (array, k) = match i - np - nq {
+            k if k < nv => ("v", k),
+            k if k < nv + nq => ("dq", k - nv),
+            k => ("dv", k - nv - nq),
+        };
+        let (array, k) = (format_ident!("{array}"), Literal::usize_unsuffixed(k));
+        quote! { #array[#k] }
     }
 }
 

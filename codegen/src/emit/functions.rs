@@ -153,6 +153,24 @@ fn emit_function(d: &Ctx, f: &Function, wall: Option<&str>) -> TokenStream {
             let array = quote! { [#(#outs),*] };
             counted(d, "Values", quote! { [f32; #nl] }, array, f.rows)
         }
+        Shape::Tangent => {
+            let m = p.outputs / 2;
+            let part = |from: usize| {
+                (0..n).map(move |i| {
+                    if i < m {
+                        let o = format_ident!("o{}", from + i);
+                        quote! { #o }
+                    } else {
+                        quote! { 0.0 }
+                    }
+                })
+            };
+            let (values, derivatives) = (part(0), part(m));
+            (
+                quote! { ([#real; #nl], [#real; #nl]) },
+                quote! { ([#(#values),*], [#(#derivatives),*]) },
+            )
+        }
         Shape::State => {
             let ql = Literal::usize_unsuffixed(q);
             let q_outs = (0..q).map(|i| format_ident!("o{i}"));
@@ -213,7 +231,8 @@ pub(super) fn dims(d: &Ctx) -> (usize, usize) {
     (d.model.coordinates.len(), d.model.velocities.len())
 }
 
-/// Nothing, `q: &[f64; Q]`, or `q: &[f64; Q], v: &[f64; N]`.
+/// Nothing, `q: &[f64; Q]`, `q: &[f64; Q], v: &[f64; N]`, or those and
+/// `dq: &[f64; Q], dv: &[f64; N]`.
 fn args(d: &Ctx, inputs: Inputs) -> TokenStream {
     let (q, n) = dims(d);
     let q = Literal::usize_unsuffixed(q);
@@ -223,6 +242,9 @@ fn args(d: &Ctx, inputs: Inputs) -> TokenStream {
         Inputs::Parameters => quote! {},
         Inputs::Coordinates => quote! { , q: &[#real; #q] },
         Inputs::Phase => quote! { , q: &[#real; #q], v: &[#real; #n] },
+        Inputs::Tangent => {
+            quote! { , q: &[#real; #q], v: &[#real; #n], dq: &[#real; #q], dv: &[#real; #n] }
+        }
     }
 }
 

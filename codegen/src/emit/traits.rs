@@ -149,6 +149,10 @@ fn forward(d: &Ctx, spec: &Spec, variants: &[Ident]) -> Option<TokenStream> {
         Inputs::Parameters => (quote! {}, quote! {}),
         Inputs::Coordinates => (quote! { q }, quote! { q: &[f64; #ql] }),
         Inputs::Phase => (quote! { q, v }, quote! { q: &[f64; #ql], v: &[f64; #nl] }),
+        Inputs::Tangent => (
+            quote! { q, v, dq, dv },
+            quote! { q: &[f64; #ql], v: &[f64; #nl], dq: &[f64; #ql], dv: &[f64; #nl] },
+        ),
     };
     let wrapped = |call: TokenStream| match wrap {
         Forward::Plain => call,
@@ -161,6 +165,7 @@ fn forward(d: &Ctx, spec: &Spec, variants: &[Ident]) -> Option<TokenStream> {
         Shape::Rows => quote! { ::dalembert_runtime::Rows<#nl> },
         Shape::Values => quote! { ::dalembert_runtime::Values<#nl> },
         Shape::State => quote! { ([f64; #ql], [f64; #nl]) },
+        Shape::Tangent => quote! { ([f64; #nl], [f64; #nl]) },
     };
     let ret = match wrap {
         Forward::Plain => ty,
@@ -171,9 +176,14 @@ fn forward(d: &Ctx, spec: &Spec, variants: &[Ident]) -> Option<TokenStream> {
         let f = format_ident!("{}", spec.name);
         (params, wrapped(quote! { self.#f(#args) }))
     } else {
+        // A wall without the function (a collision map solved at run
+        // time has no tangent program) answers `None`.
         let arms = d.derivation.walls.iter().zip(variants).map(|(w, v)| {
             let f = format_ident!("{}_{}", w.name, spec.name);
-            let value = wrapped(quote! { self.#f(#args) });
+            let value = match (w.function(spec.quantity), wrap) {
+                (None, Forward::Some) => quote! { None },
+                _ => wrapped(quote! { self.#f(#args) }),
+            };
             quote! { Wall::#v => #value }
         });
         (

@@ -49,12 +49,20 @@ impl Compiled {
 
     /// Runs on (parameters, `q`, `v`) and hands the outputs to `read`.
     fn eval<R>(&self, np: usize, q: &[f64], v: &[f64], read: impl FnOnce(&[f64]) -> R) -> R {
+        self.eval_parts(np, &[q, v], read)
+    }
+
+    /// Runs on the parameters followed by `parts` in turn (as many values
+    /// as the program has inputs) and hands the outputs to `read`.
+    fn eval_parts<R>(&self, np: usize, parts: &[&[f64]], read: impl FnOnce(&[f64]) -> R) -> R {
         let mut r = self.registers.borrow_mut();
         let inputs = self.tape.inputs;
-        let nq = q.len().min(inputs.saturating_sub(np));
-        r[np..np + nq].copy_from_slice(&q[..nq]);
-        let nv = v.len().min(inputs.saturating_sub(np + nq));
-        r[np + nq..np + nq + nv].copy_from_slice(&v[..nv]);
+        let mut at = np;
+        for part in parts {
+            let k = part.len().min(inputs.saturating_sub(at));
+            r[at..at + k].copy_from_slice(&part[..k]);
+            at += k;
+        }
         self.tape.run(&mut r);
         read(self.tape.outputs(&r))
     }
@@ -82,6 +90,8 @@ struct WallPrograms {
     /// The collision map's program (closed form, linear or elimination);
     /// `None`: solved at run time from G and B, as a generated model does.
     collide: Option<Compiled>,
+    /// The collision map's tangent program, where it has a program.
+    collide_tangent: Option<Compiled>,
 }
 
 /// Which wall of an [`Interpreted`] model: its index in file order.
@@ -111,6 +121,7 @@ pub struct Interpreted<const N: usize> {
     forcing: Compiled,
     drift: Compiled,
     accelerations: Option<Compiled>,
+    accelerations_tangent: Option<Compiled>,
     /// The Taylor series, where q̈ is written out.
     series: Option<SeriesPrograms>,
     walls: Vec<WallPrograms>,
@@ -237,6 +248,7 @@ impl<const N: usize> Interpreted<N> {
                 rows: wall_fn(Quantity::WallRows)?,
                 projector: find(&w.functions, Quantity::Projector),
                 collide: find(&w.functions, Quantity::Collide),
+                collide_tangent: find(&w.functions, Quantity::CollideTangent),
             });
         }
         let series =
@@ -256,6 +268,7 @@ impl<const N: usize> Interpreted<N> {
             forcing: model_fn(Quantity::Forcing)?,
             drift: model_fn(Quantity::ConstraintDrift)?,
             accelerations: find(&d.functions, Quantity::Accelerations),
+            accelerations_tangent: find(&d.functions, Quantity::AccelerationsTangent),
             indices: (0..walls.len()).map(WallIndex).collect(),
             walls,
             values,
@@ -274,7 +287,8 @@ impl<const N: usize> Interpreted<N> {
         ]
         .into_iter()
         .chain(self.holonomic.as_mut())
-        .chain(self.accelerations.as_mut());
+        .chain(self.accelerations.as_mut())
+        .chain(self.accelerations_tangent.as_mut());
         let walls = self.walls.iter_mut().flat_map(|w| {
             [
                 &mut w.surface,
@@ -286,6 +300,7 @@ impl<const N: usize> Interpreted<N> {
             .into_iter()
             .chain(w.projector.as_mut())
             .chain(w.collide.as_mut())
+            .chain(w.collide_tangent.as_mut())
         });
         model.chain(walls)
     }
@@ -305,6 +320,19 @@ impl<const N: usize> Interpreted<N> {
                 *x = *y;
             }
             out
+        })
+    }
+
+    /// A tangent program's values and derivatives at (q, v) along
+    /// (dq, dv).
+    fn tangent(&self, c: &Compiled, [q, v, dq, dv]: [&[f64; N]; 4]) -> ([f64; N], [f64; N]) {
+        c.eval_parts(self.np(), &[q, v, dq, dv], |o| {
+            let m = o.len() / 2;
+            let at = |i: usize| if i < m { o[i] } else { 0.0 };
+            (
+                core::array::from_fn(at),
+                core::array::from_fn(|i| if i < m { o[m + i] } else { 0.0 }),
+            )
         })
     }
 
@@ -412,6 +440,17 @@ impl<const N: usize> Walls<N, N> for Interpreted<N> {
             }
         }
     }
+    fn collide_tangent(
+        &self,
+        wall: WallIndex,
+        q: &[f64; N],
+        v: &[f64; N],
+        dq: &[f64; N],
+        dv: &[f64; N],
+    ) -> Option<([f64; N], [f64; N])> {
+        let c = self.wall(wall).collide_tangent.as_ref()?;
+        Some(self.tangent(c, [q, v, dq, dv]))
+    }
     fn normal(&self, wall: WallIndex, q: &[f64; N]) -> [f64; N] {
         self.vector(&self.wall(wall).normal, q, &[])
     }
@@ -444,6 +483,16 @@ impl<const N: usize> Dynamics<N> for Interpreted<N> {
     }
     fn closed_form_accelerations(&self, q: &[f64; N], v: &[f64; N]) -> Option<[f64; N]> {
         self.accelerations.as_ref().map(|c| self.vector(c, q, v))
+    }
+    fn accelerations_tangent(
+        &self,
+        q: &[f64; N],
+        v: &[f64; N],
+        dq: &[f64; N],
+        dv: &[f64; N],
+    ) -> Option<([f64; N], [f64; N])> {
+        let c = self.accelerations_tangent.as_ref()?;
+        Some(self.tangent(c, [q, v, dq, dv]))
     }
     /// The interpreter keeps its room itself (`SeriesPrograms::workspace`,
     /// sized by the first call and reused by every simulator after it).

@@ -9,6 +9,7 @@ mod elimination;
 mod hoist;
 mod linear;
 pub mod machine;
+mod tangent;
 mod taylor;
 
 use std::collections::HashMap;

@@ -15,9 +15,10 @@
 //   floor_b_rows                 0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_projector              0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_collide                4 add, 9 mul, 0 div, 0 fn (13 in all)
+//   floor_collide_tangent        8 add, 18 mul, 0 div, 0 fn (26 in all)
 //
-// Parameter-only work, done once when the parameters are set (11 values kept):
-//   all functions                3 add, 21 mul, 2 div, 0 fn (26 in all)
+// Parameter-only work, done once when the parameters are set (15 values kept):
+//   all functions                5 add, 31 mul, 3 div, 0 fn (39 in all)
 //
 // Solves, the cheapest form per call (cost: add + mul + 4 div + 20 fn):
 //   floor_collide                M v, M = I - 2P kept with the parameters [linear 13, closed form 15, elimination 23]
@@ -59,7 +60,7 @@ pub struct BallFloor {
     /// `set_parameter`, which keep `pre` up to date).
     params: Params,
     /// The parameter-only values the functions read.
-    pre: [f64; 11],
+    pre: [f64; 15],
 }
 impl Default for BallFloor {
     /// The model with the model file's parameter values.
@@ -114,8 +115,8 @@ impl BallFloor {
     }
     /// The parameter-only values the functions read, from `params`.
     #[allow(unused_variables, unused_mut, clippy::approx_constant)]
-    fn precompute(params: &Params) -> [f64; 11] {
-        let mut pre: [f64; 11] = [0.0; 11];
+    fn precompute(params: &Params) -> [f64; 15] {
+        let mut pre: [f64; 15] = [0.0; 15];
         {
             let i1: f64 = params.r;
             let o10: f64 = -(i1);
@@ -165,6 +166,26 @@ impl BallFloor {
             pre[9] = t2;
             let t3: f64 = i0 * t3;
             pre[10] = t3;
+        }
+        {
+            let i0: f64 = params.m;
+            let i1: f64 = params.r;
+            let i2: f64 = params.J;
+            let t0: f64 = i1 * i1;
+            let t1: f64 = i0 * t0;
+            let t2: f64 = i2 + t1;
+            let t3: f64 = 1.0 / (t2);
+            let t4: f64 = i2 * -2f64 * t3;
+            let t5: f64 = 1f64 + t4;
+            pre[11] = t5;
+            let t6: f64 = i1 * t3;
+            let t7: f64 = 2f64 * t6;
+            let t8: f64 = i2 * t7;
+            pre[12] = t8;
+            let t9: f64 = i0 * -2f64 * t6;
+            pre[13] = t9;
+            let t10: f64 = i0 * t7;
+            pre[14] = t10;
         }
         pre
     }
@@ -395,6 +416,72 @@ impl BallFloor {
         let o5: f64 = i8;
         [o0, o1, o2, o3, o4, o5]
     }
+    /// Wall `floor`: v⁺ as `collide` computes it, and its derivative along (δq, δv⁻): (v⁺, ∂v⁺/∂q δq + ∂v⁺/∂v⁻ δv⁻), by forward differentiation of the same program.
+    #[inline]
+    #[allow(unused_variables, clippy::approx_constant)]
+    pub fn floor_collide_tangent(
+        &self,
+        q: &[f64; 0],
+        v: &[f64; 6],
+        dq: &[f64; 0],
+        dv: &[f64; 6],
+    ) -> ([f64; 6], [f64; 6]) {
+        let i3: f64 = v[0];
+        let i4: f64 = v[1];
+        let i5: f64 = v[2];
+        let i6: f64 = v[3];
+        let i7: f64 = v[4];
+        let i8: f64 = v[5];
+        let i9: f64 = dv[0];
+        let i10: f64 = dv[1];
+        let i11: f64 = dv[2];
+        let i12: f64 = dv[3];
+        let i13: f64 = dv[4];
+        let i14: f64 = dv[5];
+        let t5: f64 = self.pre[11];
+        let t8: f64 = self.pre[12];
+        let t9: f64 = self.pre[13];
+        let t10: f64 = self.pre[14];
+        let t11: f64 = t5 * i3;
+        let t12: f64 = t5 * i9;
+        let t13: f64 = t8 * i7;
+        let t14: f64 = t8 * i13;
+        let t15: f64 = t11 + t13;
+        let t16: f64 = t12 + t14;
+        let t17: f64 = t5 * i4;
+        let t18: f64 = t5 * i10;
+        let t19: f64 = t8 * i6;
+        let t20: f64 = t8 * i12;
+        let t21: f64 = t17 - t19;
+        let t22: f64 = t18 - t20;
+        let t23: f64 = -(i5);
+        let t24: f64 = -(i11);
+        let t25: f64 = t9 * i4;
+        let t26: f64 = t9 * i10;
+        let t27: f64 = t5 * i6;
+        let t28: f64 = t5 * i12;
+        let t29: f64 = t25 - t27;
+        let t30: f64 = t26 - t28;
+        let t31: f64 = t10 * i3;
+        let t32: f64 = t10 * i9;
+        let t33: f64 = t5 * i7;
+        let t34: f64 = t5 * i13;
+        let t35: f64 = t31 - t33;
+        let t36: f64 = t32 - t34;
+        let o0: f64 = t15;
+        let o6: f64 = t16;
+        let o1: f64 = t21;
+        let o7: f64 = t22;
+        let o2: f64 = t23;
+        let o8: f64 = t24;
+        let o3: f64 = t29;
+        let o9: f64 = t30;
+        let o4: f64 = t35;
+        let o10: f64 = t36;
+        let o5: f64 = i8;
+        let o11: f64 = i14;
+        ([o0, o1, o2, o3, o4, o5], [o6, o7, o8, o9, o10, o11])
+    }
 }
 impl ::dalembert_runtime::Model<0, 6> for BallFloor {
     fn name(&self) -> &str {
@@ -497,6 +584,19 @@ impl ::dalembert_runtime::Walls<0, 6> for BallFloor {
     fn collide(&self, wall: Wall, q: &[f64; 0], v: &[f64; 6]) -> [f64; 6] {
         match wall {
             Wall::Floor => self.floor_collide(q, v),
+        }
+    }
+    #[inline]
+    fn collide_tangent(
+        &self,
+        wall: Wall,
+        q: &[f64; 0],
+        v: &[f64; 6],
+        dq: &[f64; 0],
+        dv: &[f64; 6],
+    ) -> Option<([f64; 6], [f64; 6])> {
+        match wall {
+            Wall::Floor => Some(self.floor_collide_tangent(q, v, dq, dv)),
         }
     }
 }

@@ -15,9 +15,10 @@
 //   floor_b_rows                 0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_projector              0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_collide                4 add, 9 mul, 0 div, 0 fn (13 in all)
+//   floor_collide_tangent        8 add, 18 mul, 0 div, 0 fn (26 in all)
 //
-// Parameter-only work, done once when the parameters are set (11 values kept):
-//   all functions                3 add, 21 mul, 2 div, 0 fn (26 in all)
+// Parameter-only work, done once when the parameters are set (15 values kept):
+//   all functions                5 add, 31 mul, 3 div, 0 fn (39 in all)
 //
 // Solves, the cheapest form per call (cost: add + mul + 4 div + 20 fn):
 //   floor_collide                M v, M = I - 2P kept with the parameters [linear 13, closed form 15, elimination 23]
@@ -59,7 +60,7 @@ pub struct BallFloor {
     /// `set_parameter`, which keep `pre` up to date).
     params: Params,
     /// The parameter-only values the functions read.
-    pre: [f32; 11],
+    pre: [f32; 15],
 }
 impl Default for BallFloor {
     /// The model with the model file's parameter values.
@@ -114,8 +115,8 @@ impl BallFloor {
     }
     /// The parameter-only values the functions read, from `params`.
     #[allow(unused_variables, unused_mut, clippy::approx_constant)]
-    fn precompute(params: &Params) -> [f32; 11] {
-        let mut pre: [f32; 11] = [0.0; 11];
+    fn precompute(params: &Params) -> [f32; 15] {
+        let mut pre: [f32; 15] = [0.0; 15];
         {
             let i1: f32 = params.r;
             let o10: f32 = -(i1);
@@ -165,6 +166,26 @@ impl BallFloor {
             pre[9] = t2;
             let t3: f32 = i0 * t3;
             pre[10] = t3;
+        }
+        {
+            let i0: f32 = params.m;
+            let i1: f32 = params.r;
+            let i2: f32 = params.J;
+            let t0: f32 = i1 * i1;
+            let t1: f32 = i0 * t0;
+            let t2: f32 = i2 + t1;
+            let t3: f32 = 1.0 / (t2);
+            let t4: f32 = i2 * -2f32 * t3;
+            let t5: f32 = 1f32 + t4;
+            pre[11] = t5;
+            let t6: f32 = i1 * t3;
+            let t7: f32 = 2f32 * t6;
+            let t8: f32 = i2 * t7;
+            pre[12] = t8;
+            let t9: f32 = i0 * -2f32 * t6;
+            pre[13] = t9;
+            let t10: f32 = i0 * t7;
+            pre[14] = t10;
         }
         pre
     }
@@ -394,5 +415,71 @@ impl BallFloor {
         let o4: f32 = t14 - t15;
         let o5: f32 = i8;
         [o0, o1, o2, o3, o4, o5]
+    }
+    /// Wall `floor`: v⁺ as `collide` computes it, and its derivative along (δq, δv⁻): (v⁺, ∂v⁺/∂q δq + ∂v⁺/∂v⁻ δv⁻), by forward differentiation of the same program.
+    #[inline]
+    #[allow(unused_variables, clippy::approx_constant)]
+    pub fn floor_collide_tangent(
+        &self,
+        q: &[f32; 0],
+        v: &[f32; 6],
+        dq: &[f32; 0],
+        dv: &[f32; 6],
+    ) -> ([f32; 6], [f32; 6]) {
+        let i3: f32 = v[0];
+        let i4: f32 = v[1];
+        let i5: f32 = v[2];
+        let i6: f32 = v[3];
+        let i7: f32 = v[4];
+        let i8: f32 = v[5];
+        let i9: f32 = dv[0];
+        let i10: f32 = dv[1];
+        let i11: f32 = dv[2];
+        let i12: f32 = dv[3];
+        let i13: f32 = dv[4];
+        let i14: f32 = dv[5];
+        let t5: f32 = self.pre[11];
+        let t8: f32 = self.pre[12];
+        let t9: f32 = self.pre[13];
+        let t10: f32 = self.pre[14];
+        let t11: f32 = t5 * i3;
+        let t12: f32 = t5 * i9;
+        let t13: f32 = t8 * i7;
+        let t14: f32 = t8 * i13;
+        let t15: f32 = t11 + t13;
+        let t16: f32 = t12 + t14;
+        let t17: f32 = t5 * i4;
+        let t18: f32 = t5 * i10;
+        let t19: f32 = t8 * i6;
+        let t20: f32 = t8 * i12;
+        let t21: f32 = t17 - t19;
+        let t22: f32 = t18 - t20;
+        let t23: f32 = -(i5);
+        let t24: f32 = -(i11);
+        let t25: f32 = t9 * i4;
+        let t26: f32 = t9 * i10;
+        let t27: f32 = t5 * i6;
+        let t28: f32 = t5 * i12;
+        let t29: f32 = t25 - t27;
+        let t30: f32 = t26 - t28;
+        let t31: f32 = t10 * i3;
+        let t32: f32 = t10 * i9;
+        let t33: f32 = t5 * i7;
+        let t34: f32 = t5 * i13;
+        let t35: f32 = t31 - t33;
+        let t36: f32 = t32 - t34;
+        let o0: f32 = t15;
+        let o6: f32 = t16;
+        let o1: f32 = t21;
+        let o7: f32 = t22;
+        let o2: f32 = t23;
+        let o8: f32 = t24;
+        let o3: f32 = t29;
+        let o9: f32 = t30;
+        let o4: f32 = t35;
+        let o10: f32 = t36;
+        let o5: f32 = i8;
+        let o11: f32 = i14;
+        ([o0, o1, o2, o3, o4, o5], [o6, o7, o8, o9, o10, o11])
     }
 }

@@ -22,6 +22,7 @@
 //   forcing                      13 add, 34 mul, 0 div, 4 fn (51 in all)
 //   constraint_drift             4 add, 14 mul, 0 div, 4 fn (22 in all)
 //   accelerations                5 add, 18 mul, 1 div, 4 fn (28 in all)
+//   accelerations_tangent        19 add, 60 mul, 1 div, 4 fn (84 in all)
 //   initial_state                0 add, 1 mul, 0 div, 0 fn (1 in all)
 //   wall_surface                 1 add, 0 mul, 0 div, 0 fn (1 in all)
 //   wall_normal                  0 add, 0 mul, 0 div, 0 fn (0 in all)
@@ -30,9 +31,10 @@
 //   wall_b_rows                  0 add, 6 mul, 0 div, 4 fn (10 in all)
 //   wall_projector               10 add, 40 mul, 1 div, 4 fn (55 in all)
 //   wall_collide                 25 add, 55 mul, 1 div, 4 fn (85 in all)
+//   wall_collide_tangent         73 add, 155 mul, 1 div, 4 fn (233 in all)
 //
-// Parameter-only work, done once when the parameters are set (41 values kept):
-//   all functions                6 add, 47 mul, 6 div, 0 fn (59 in all)
+// Parameter-only work, done once when the parameters are set (59 values kept):
+//   all functions                10 add, 70 mul, 8 div, 0 fn (88 in all)
 //
 // Solves, the cheapest form per call (cost: add + mul + 4 div + 20 fn):
 //   wall_collide                 the exact closed form [closed form 164, elimination 220]
@@ -87,7 +89,7 @@ pub struct BallWallEuler {
     /// `set_parameter`, which keep `pre` up to date).
     params: Params,
     /// The parameter-only values the functions read.
-    pre: [f32; 41],
+    pre: [f32; 59],
 }
 impl Default for BallWallEuler {
     /// The model with the model file's parameter values.
@@ -141,8 +143,8 @@ impl BallWallEuler {
     }
     /// The parameter-only values the functions read, from `params`.
     #[allow(unused_variables, unused_mut, clippy::approx_constant)]
-    fn precompute(params: &Params) -> [f32; 41] {
-        let mut pre: [f32; 41] = [0.0; 41];
+    fn precompute(params: &Params) -> [f32; 59] {
+        let mut pre: [f32; 59] = [0.0; 59];
         {
             let i0: f32 = params.m;
             let i1: f32 = params.r;
@@ -192,14 +194,32 @@ impl BallWallEuler {
             let o0: f32 = t0;
         }
         {
+            let i0: f32 = params.m;
+            let i1: f32 = params.r;
+            let i2: f32 = params.J;
+            let i4: f32 = params.a;
+            let t0: f32 = i1 * i1;
+            let t1: f32 = i0 * t0;
+            let t2: f32 = i2 + t1;
+            pre[12] = t2;
+            let t3: f32 = 1.0 / (t2);
+            pre[13] = t3;
+            let t4: f32 = -(i4);
+            let t5: f32 = t1 * t3 * t4;
+            pre[15] = t5;
+            let t6: f32 = i0 * i1 * t4;
+            pre[14] = t6;
+            let o0: f32 = t5;
+        }
+        {
             let i1: f32 = params.r;
             let o0: f32 = -(i1);
-            pre[12] = o0;
+            pre[16] = o0;
         }
         {
             let i1: f32 = params.r;
             let o17: f32 = -(i1);
-            pre[13] = o17;
+            pre[17] = o17;
         }
         {
             let i0: f32 = params.m;
@@ -208,32 +228,32 @@ impl BallWallEuler {
             let t6: f32 = i1 * i1;
             let t6: f32 = i0 * t6;
             let t8: f32 = i2 * 2f32;
-            pre[14] = t8;
+            pre[18] = t8;
             let t4: f32 = t6 + t8;
-            pre[15] = t4;
+            pre[19] = t4;
             let t3: f32 = 1.0 / (t4);
-            pre[16] = t3;
+            pre[20] = t3;
             let t10: f32 = i2 * t3;
-            pre[17] = t10;
+            pre[21] = t10;
             let t0: f32 = 2f32 * t10;
-            pre[26] = t0;
+            pre[30] = t0;
             let t5: f32 = -(i1);
             let t1: f32 = t10 * t5;
-            pre[27] = t1;
+            pre[31] = t1;
             let t2: f32 = i1 * i2;
             let t5: f32 = i0 * t5;
-            pre[18] = t5;
+            pre[22] = t5;
             let t6: f32 = i2 + t6;
-            pre[19] = t6;
+            pre[23] = t6;
             let t7: f32 = -(i2);
-            pre[20] = t7;
+            pre[24] = t7;
             let t9: f32 = i0 * i1 * t3;
-            pre[21] = t9;
-            pre[22] = -(t1);
-            pre[23] = t2 * t3;
+            pre[25] = t9;
+            pre[26] = -(t1);
+            pre[27] = t2 * t3;
             let t15: f32 = 1.0 / (t4);
-            pre[24] = t15;
-            pre[25] = -(t5);
+            pre[28] = t15;
+            pre[29] = -(t5);
             let o6: f32 = t0;
             let o7: f32 = t1;
         }
@@ -242,37 +262,74 @@ impl BallWallEuler {
             let i1: f32 = params.r;
             let i2: f32 = params.J;
             let t0: f32 = i1 * i2;
-            pre[28] = t0;
+            pre[32] = t0;
             let t6: f32 = i1 * i1;
             let t6: f32 = i0 * t6;
             let t8: f32 = i2 * 2f32;
-            pre[29] = t8;
+            pre[33] = t8;
             let t4: f32 = t6 + t8;
-            pre[30] = t4;
+            pre[34] = t4;
             let t3: f32 = 1.0 / (t4);
             let t2: f32 = i2 * t3;
             let t1: f32 = i1 * 2f32 * t2;
-            pre[31] = t1;
+            pre[35] = t1;
             let t2: f32 = -4f32 * t2;
             let t2: f32 = 1f32 + t2;
-            pre[32] = t2;
+            pre[36] = t2;
             let t3: f32 = -2f32 * t3;
-            pre[33] = t3;
+            pre[37] = t3;
             let t11: f32 = i0 * i1;
             let t5: f32 = -(t11);
-            pre[34] = t5;
+            pre[38] = t5;
             let t6: f32 = i2 + t6;
-            pre[35] = t6;
+            pre[39] = t6;
             let t7: f32 = -(i2);
-            pre[36] = t7;
+            pre[40] = t7;
             let t9: f32 = t3 * t11;
-            pre[37] = t9;
+            pre[41] = t9;
             let t10: f32 = i2 * t3;
-            pre[38] = t10;
+            pre[42] = t10;
             let t11: f32 = -2f32 * t11;
-            pre[39] = t11;
+            pre[43] = t11;
             let t18: f32 = 1.0 / (t4);
-            pre[40] = t18;
+            pre[44] = t18;
+        }
+        {
+            let i0: f32 = params.m;
+            let i1: f32 = params.r;
+            let i2: f32 = params.J;
+            let t0: f32 = i1 * i2;
+            pre[45] = t0;
+            let t1: f32 = i1 * i1;
+            let t2: f32 = i0 * t1;
+            let t3: f32 = i2 * 2f32;
+            pre[46] = t3;
+            let t4: f32 = t2 + t3;
+            pre[47] = t4;
+            let t5: f32 = 1.0 / (t4);
+            pre[48] = t5;
+            let t6: f32 = i2 * t5;
+            let t7: f32 = i1 * 2f32 * t6;
+            pre[49] = t7;
+            let t8: f32 = -4f32 * t6;
+            let t9: f32 = 1f32 + t8;
+            pre[50] = t9;
+            let t10: f32 = -2f32 * t5;
+            pre[51] = t10;
+            let t11: f32 = i0 * i1;
+            let t12: f32 = -(t11);
+            pre[52] = t12;
+            let t13: f32 = i2 + t2;
+            pre[53] = t13;
+            let t14: f32 = -(i2);
+            pre[54] = t14;
+            let t15: f32 = t10 * t11;
+            pre[55] = t15;
+            let t16: f32 = i2 * t10;
+            pre[56] = t16;
+            let t17: f32 = -2f32 * t11;
+            pre[57] = t17;
+            pre[58] = t0 * t10;
         }
         pre
     }
@@ -536,6 +593,110 @@ impl BallWallEuler {
         let o1: f32 = 0f32;
         [o0, o1, o2, o3, o4]
     }
+    /// q̈ as `accelerations` computes it, and its derivative along (δq, δv): (q̈, ∂q̈/∂q δq + ∂q̈/∂v δv), by forward differentiation of the same program. A column of the Jacobian for a unit direction.
+    #[inline]
+    #[allow(unused_variables, clippy::approx_constant)]
+    pub fn accelerations_tangent(
+        &self,
+        q: &[f32; 5],
+        v: &[f32; 5],
+        dq: &[f32; 5],
+        dv: &[f32; 5],
+    ) -> ([f32; 5], [f32; 5]) {
+        let i7: f32 = q[2];
+        let i8: f32 = q[3];
+        let i12: f32 = v[2];
+        let i13: f32 = v[3];
+        let i14: f32 = v[4];
+        let i17: f32 = dq[2];
+        let i18: f32 = dq[3];
+        let i22: f32 = dv[2];
+        let i23: f32 = dv[3];
+        let i24: f32 = dv[4];
+        let t2: f32 = self.pre[12];
+        let t3: f32 = self.pre[13];
+        let t6: f32 = self.pre[14];
+        let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
+        let t7: f32 = sc0_cos;
+        let t8: f32 = sc0_sin;
+        let t9: f32 = -(t8 * i18);
+        let t10: f32 = -(t7);
+        let t11: f32 = -(t9);
+        let t12: f32 = i12 * t10;
+        let t13: f32 = t10 * i22;
+        let t14: f32 = i12 * t11;
+        let t15: f32 = t13 + t14;
+        let t16: f32 = i14 + t12;
+        let t17: f32 = i24 + t15;
+        let t18: f32 = i13 * t2;
+        let t19: f32 = t2 * i23;
+        let t20: f32 = t16 * t18;
+        let t21: f32 = t18 * t17;
+        let t22: f32 = t16 * t19;
+        let t23: f32 = t21 + t22;
+        let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
+        let t24: f32 = sc1_cos;
+        let t25: f32 = sc1_sin;
+        let t26: f32 = -(t25 * i17);
+        let t27: f32 = t6 * t24;
+        let t28: f32 = t6 * t26;
+        let t29: f32 = t7 * t27;
+        let t30: f32 = t27 * t9;
+        let t31: f32 = t7 * t28;
+        let t32: f32 = t30 + t31;
+        let t33: f32 = t20 + t29;
+        let t34: f32 = t23 + t32;
+        let t35: f32 = t7 * i18;
+        let t36: f32 = 1.0 / (t8);
+        let t37: f32 = -(t36 * t36 * t35);
+        let t38: f32 = t3 * t36;
+        let t39: f32 = t3 * t37;
+        let t40: f32 = t33 * t38;
+        let t41: f32 = t38 * t34;
+        let t42: f32 = t33 * t39;
+        let t43: f32 = t41 + t42;
+        let t44: f32 = -(i12 * i14 * t2 * t8);
+        let t45: f32 = -(i14 * t2 * t8 * i22);
+        let t46: f32 = -(i12 * t2 * t8 * i24);
+        let t47: f32 = -(i12 * i14 * t2 * t35);
+        let t48: f32 = t45 + t46 + t47;
+        let t49: f32 = t24 * i17;
+        let t50: f32 = t6 * t25;
+        let t51: f32 = t6 * t49;
+        let t52: f32 = t44 + t50;
+        let t53: f32 = t48 + t51;
+        let t54: f32 = t3 * t52;
+        let t55: f32 = t3 * t53;
+        let t56: f32 = i14 * t10;
+        let t57: f32 = t10 * i24;
+        let t58: f32 = i14 * t11;
+        let t59: f32 = t57 + t58;
+        let t60: f32 = i12 + t56;
+        let t61: f32 = i22 + t59;
+        let t62: f32 = t18 * t60;
+        let t63: f32 = t60 * t19;
+        let t64: f32 = t18 * t61;
+        let t65: f32 = t63 + t64;
+        let t66: f32 = -(t27);
+        let t67: f32 = -(t28);
+        let t68: f32 = t62 + t66;
+        let t69: f32 = t65 + t67;
+        let t70: f32 = t38 * t68;
+        let t71: f32 = t68 * t39;
+        let t72: f32 = t38 * t69;
+        let t73: f32 = t71 + t72;
+        let o0: f32 = self.pre[15];
+        let o5: f32 = 0f32;
+        let o1: f32 = 0f32;
+        let o6: f32 = 0f32;
+        let o2: f32 = t40;
+        let o7: f32 = t43;
+        let o3: f32 = t54;
+        let o8: f32 = t55;
+        let o4: f32 = t70;
+        let o9: f32 = t73;
+        ([o0, o1, o2, o3, o4], [o5, o6, o7, o8, o9])
+    }
     /// The starting state of the model file's `[initial]` (zero where it is silent), at these parameters: (q, q̇).
     #[inline]
     #[allow(unused_variables, clippy::approx_constant)]
@@ -557,7 +718,7 @@ impl BallWallEuler {
     #[allow(unused_variables, clippy::approx_constant)]
     pub fn wall_surface(&self, q: &[f32; 5]) -> f32 {
         let i5: f32 = q[0];
-        let o0: f32 = self.pre[12];
+        let o0: f32 = self.pre[16];
         let o0: f32 = i5 + o0;
         o0
     }
@@ -596,7 +757,7 @@ impl BallWallEuler {
         let i8: f32 = q[3];
         let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
         let o14: f32 = sc0_sin;
-        let o17: f32 = self.pre[13];
+        let o17: f32 = self.pre[17];
         let o8: f32 = o14 * o17;
         let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
         let o19: f32 = sc1_sin;
@@ -638,17 +799,17 @@ impl BallWallEuler {
         let i2: f32 = self.params.J;
         let i7: f32 = q[2];
         let i8: f32 = q[3];
-        let t8: f32 = self.pre[14];
-        let t4: f32 = self.pre[15];
-        let t3: f32 = self.pre[16];
-        let t10: f32 = self.pre[17];
-        let t5: f32 = self.pre[18];
-        let t6: f32 = self.pre[19];
-        let t7: f32 = self.pre[20];
-        let t9: f32 = self.pre[21];
+        let t8: f32 = self.pre[18];
+        let t4: f32 = self.pre[19];
+        let t3: f32 = self.pre[20];
+        let t10: f32 = self.pre[21];
+        let t5: f32 = self.pre[22];
+        let t6: f32 = self.pre[23];
+        let t7: f32 = self.pre[24];
+        let t9: f32 = self.pre[25];
         let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
         let o23: f32 = sc0_cos;
-        let o8: f32 = self.pre[22] * o23;
+        let o8: f32 = self.pre[26] * o23;
         let o21: f32 = sc0_sin;
         let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
         let o24: f32 = sc1_sin;
@@ -656,8 +817,8 @@ impl BallWallEuler {
         let o17: f32 = sc1_cos;
         let o9: f32 = -(o17);
         let t15: f32 = t15 + o9;
-        let o9: f32 = self.pre[23] * t15;
-        let t15: f32 = self.pre[24];
+        let o9: f32 = self.pre[27] * t15;
+        let t15: f32 = self.pre[28];
         let t18: f32 = o21 * o17;
         let o11: f32 = o24 + t18;
         let o18: f32 = 1.0 / (o24);
@@ -690,7 +851,7 @@ impl BallWallEuler {
         let o22: f32 = o22 + o19;
         let o19: f32 = t3 * o23 * o22;
         let o22: f32 = o21 * t15;
-        let o21: f32 = self.pre[25] * o22;
+        let o21: f32 = self.pre[29] * o22;
         let o22: f32 = i2 * o22;
         let o23: f32 = o23 * t15 * t27;
         let t27: f32 = i2 * t18;
@@ -704,8 +865,8 @@ impl BallWallEuler {
         let o3: f32 = 0f32;
         let o4: f32 = 0f32;
         let o5: f32 = 0f32;
-        let o6: f32 = self.pre[26];
-        let o7: f32 = self.pre[27];
+        let o6: f32 = self.pre[30];
+        let o7: f32 = self.pre[31];
         let o10: f32 = 0f32;
         let o15: f32 = 0f32;
         let o20: f32 = 0f32;
@@ -729,18 +890,18 @@ impl BallWallEuler {
         let i12: f32 = v[2];
         let i13: f32 = v[3];
         let i14: f32 = v[4];
-        let t0: f32 = self.pre[28];
-        let t8: f32 = self.pre[29];
-        let t4: f32 = self.pre[30];
-        let t1: f32 = self.pre[31];
-        let t2: f32 = self.pre[32];
-        let t3: f32 = self.pre[33];
-        let t5: f32 = self.pre[34];
-        let t6: f32 = self.pre[35];
-        let t7: f32 = self.pre[36];
-        let t9: f32 = self.pre[37];
-        let t10: f32 = self.pre[38];
-        let t11: f32 = self.pre[39];
+        let t0: f32 = self.pre[32];
+        let t8: f32 = self.pre[33];
+        let t4: f32 = self.pre[34];
+        let t1: f32 = self.pre[35];
+        let t2: f32 = self.pre[36];
+        let t3: f32 = self.pre[37];
+        let t5: f32 = self.pre[38];
+        let t6: f32 = self.pre[39];
+        let t7: f32 = self.pre[40];
+        let t9: f32 = self.pre[41];
+        let t10: f32 = self.pre[42];
+        let t11: f32 = self.pre[43];
         let o0: f32 = -(i10);
         let o1: f32 = i11 * t2;
         let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
@@ -758,7 +919,7 @@ impl BallWallEuler {
         let t21: f32 = i12 + t21;
         let t21: f32 = t1 * t21;
         let o1: f32 = o1 + t18 + t21;
-        let t18: f32 = self.pre[40];
+        let t18: f32 = self.pre[44];
         let t21: f32 = t6 * t15;
         let t22: f32 = t14 * t17;
         let t23: f32 = t7 * t22;
@@ -816,5 +977,247 @@ impl BallWallEuler {
         let t19: f32 = t8 * t27;
         let o4: f32 = t21 + t18 + t19;
         [o0, o1, o2, o3, o4]
+    }
+    /// Wall `wall`: v⁺ as `collide` computes it, and its derivative along (δq, δv⁻): (v⁺, ∂v⁺/∂q δq + ∂v⁺/∂v⁻ δv⁻), by forward differentiation of the same program.
+    #[inline]
+    #[allow(unused_variables, clippy::approx_constant)]
+    pub fn wall_collide_tangent(
+        &self,
+        q: &[f32; 5],
+        v: &[f32; 5],
+        dq: &[f32; 5],
+        dv: &[f32; 5],
+    ) -> ([f32; 5], [f32; 5]) {
+        let i2: f32 = self.params.J;
+        let i7: f32 = q[2];
+        let i8: f32 = q[3];
+        let i10: f32 = v[0];
+        let i11: f32 = v[1];
+        let i12: f32 = v[2];
+        let i13: f32 = v[3];
+        let i14: f32 = v[4];
+        let i17: f32 = dq[2];
+        let i18: f32 = dq[3];
+        let i20: f32 = dv[0];
+        let i21: f32 = dv[1];
+        let i22: f32 = dv[2];
+        let i23: f32 = dv[3];
+        let i24: f32 = dv[4];
+        let t0: f32 = self.pre[45];
+        let t3: f32 = self.pre[46];
+        let t4: f32 = self.pre[47];
+        let t5: f32 = self.pre[48];
+        let t7: f32 = self.pre[49];
+        let t9: f32 = self.pre[50];
+        let t10: f32 = self.pre[51];
+        let t12: f32 = self.pre[52];
+        let t13: f32 = self.pre[53];
+        let t14: f32 = self.pre[54];
+        let t15: f32 = self.pre[55];
+        let t16: f32 = self.pre[56];
+        let t17: f32 = self.pre[57];
+        let t18: f32 = -(i10);
+        let t19: f32 = -(i20);
+        let t20: f32 = i11 * t9;
+        let t21: f32 = t9 * i21;
+        let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
+        let t22: f32 = sc0_sin;
+        let t23: f32 = sc0_cos;
+        let t24: f32 = t23 * i17;
+        let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
+        let t25: f32 = sc1_sin;
+        let t26: f32 = sc1_cos;
+        let t27: f32 = t26 * i18;
+        let t28: f32 = t22 * t25;
+        let t29: f32 = t25 * t24;
+        let t30: f32 = t22 * t27;
+        let t31: f32 = t29 + t30;
+        let t32: f32 = -(t25 * i18);
+        let t33: f32 = -(t26);
+        let t34: f32 = -(t32);
+        let t35: f32 = t28 + t33;
+        let t36: f32 = t31 + t34;
+        let t37: f32 = i14 * t0 * t10 * t35;
+        let t38: f32 = self.pre[58] * t35 * i24;
+        let t39: f32 = i14 * t0 * t10 * t36;
+        let t40: f32 = t38 + t39;
+        let t41: f32 = -(t22 * i17);
+        let t42: f32 = i13 * t23;
+        let t43: f32 = t23 * i23;
+        let t44: f32 = i13 * t41;
+        let t45: f32 = t43 + t44;
+        let t46: f32 = -(t42);
+        let t47: f32 = -(t45);
+        let t48: f32 = i12 + t46;
+        let t49: f32 = i22 + t47;
+        let t50: f32 = t7 * t48;
+        let t51: f32 = t7 * t49;
+        let t52: f32 = t20 + t37 + t50;
+        let t53: f32 = t21 + t40 + t51;
+        let t54: f32 = t13 * t25;
+        let t55: f32 = t13 * t27;
+        let t56: f32 = t22 * t26;
+        let t57: f32 = t26 * t24;
+        let t58: f32 = t22 * t32;
+        let t59: f32 = t57 + t58;
+        let t60: f32 = t14 * t56;
+        let t61: f32 = t14 * t59;
+        let t62: f32 = t54 + t60;
+        let t63: f32 = t55 + t61;
+        let t64: f32 = 1.0 / (t25);
+        let t65: f32 = -(t64 * t64 * t27);
+        let t66: f32 = t5 * t64;
+        let t67: f32 = t5 * t65;
+        let t68: f32 = -2f32 * t66;
+        let t69: f32 = -2f32 * t67;
+        let t70: f32 = t62 * t68;
+        let t71: f32 = t68 * t63;
+        let t72: f32 = t62 * t69;
+        let t73: f32 = t71 + t72;
+        let t74: f32 = 1f32 + t70;
+        let t75: f32 = i12 * t74;
+        let t76: f32 = t74 * i22;
+        let t77: f32 = i12 * t73;
+        let t78: f32 = t76 + t77;
+        let t79: f32 = t25 + t56;
+        let t80: f32 = t27 + t59;
+        let t81: f32 = t66 * t79;
+        let t82: f32 = t79 * t67;
+        let t83: f32 = t66 * t80;
+        let t84: f32 = t82 + t83;
+        let t85: f32 = i2 * t42 * t81;
+        let t86: f32 = i2 * t81 * t45;
+        let t87: f32 = i2 * t42 * t84;
+        let t88: f32 = t86 + t87;
+        let t89: f32 = i11 * t12 * t81;
+        let t90: f32 = t12 * t81 * i21;
+        let t91: f32 = i11 * t12 * t84;
+        let t92: f32 = t90 + t91;
+        let t93: f32 = t25 * t26;
+        let t94: f32 = t26 * t27;
+        let t95: f32 = t25 * t32;
+        let t96: f32 = t94 + t95;
+        let t97: f32 = t22 + t93;
+        let t98: f32 = t24 + t96;
+        let t99: f32 = t14 * t97;
+        let t100: f32 = t14 * t98;
+        let t101: f32 = t22 * t22;
+        let t102: f32 = 2f32 * t22 * t24;
+        let t103: f32 = i2 * t26;
+        let t104: f32 = i2 * t32;
+        let t105: f32 = t101 * t103;
+        let t106: f32 = t103 * t102;
+        let t107: f32 = t101 * t104;
+        let t108: f32 = t106 + t107;
+        let t109: f32 = t3 * t28;
+        let t110: f32 = t3 * t31;
+        let t111: f32 = t105 + t109;
+        let t112: f32 = t108 + t110;
+        let t113: f32 = t25 * t111;
+        let t114: f32 = t111 * t27;
+        let t115: f32 = t25 * t112;
+        let t116: f32 = t114 + t115;
+        let t117: f32 = t99 + t113;
+        let t118: f32 = t100 + t116;
+        let t119: f32 = i14 * t66 * t117;
+        let t120: f32 = t66 * t117 * i24;
+        let t121: f32 = i14 * t117 * t67;
+        let t122: f32 = i14 * t66 * t118;
+        let t123: f32 = t120 + t121 + t122;
+        let t124: f32 = t85 + t89 + t119;
+        let t125: f32 = t88 + t92 + t123;
+        let t126: f32 = -2f32 * t124;
+        let t127: f32 = -2f32 * t125;
+        let t128: f32 = t75 + t126;
+        let t129: f32 = t78 + t127;
+        let t130: f32 = i2 * t101;
+        let t131: f32 = i2 * t102;
+        let t132: f32 = t13 + t130;
+        let t133: f32 = i13 * t132;
+        let t134: f32 = t132 * i23;
+        let t135: f32 = i13 * t131;
+        let t136: f32 = t134 + t135;
+        let t137: f32 = t23 * t103;
+        let t138: f32 = t103 * t41;
+        let t139: f32 = t23 * t104;
+        let t140: f32 = t138 + t139;
+        let t141: f32 = t14 * t28 * t23;
+        let t142: f32 = t14 * t23 * t31;
+        let t143: f32 = t14 * t28 * t41;
+        let t144: f32 = t142 + t143;
+        let t145: f32 = t137 + t141;
+        let t146: f32 = t140 + t144;
+        let t147: f32 = i14 * t145;
+        let t148: f32 = t145 * i24;
+        let t149: f32 = i14 * t146;
+        let t150: f32 = t148 + t149;
+        let t151: f32 = t133 + t147;
+        let t152: f32 = t136 + t150;
+        let t153: f32 = t10 * t151;
+        let t154: f32 = t10 * t152;
+        let t155: f32 = i11 * t15;
+        let t156: f32 = t15 * i21;
+        let t157: f32 = i12 * t16;
+        let t158: f32 = t16 * i22;
+        let t159: f32 = t155 + t157;
+        let t160: f32 = t156 + t158;
+        let t161: f32 = t23 * t159;
+        let t162: f32 = t159 * t41;
+        let t163: f32 = t23 * t160;
+        let t164: f32 = t162 + t163;
+        let t165: f32 = i13 + t153 + t161;
+        let t166: f32 = i23 + t154 + t164;
+        let t167: f32 = t22 * t66;
+        let t168: f32 = t66 * t24;
+        let t169: f32 = t22 * t67;
+        let t170: f32 = t168 + t169;
+        let t171: f32 = i11 * t17 * t167;
+        let t172: f32 = t17 * t167 * i21;
+        let t173: f32 = i11 * t17 * t170;
+        let t174: f32 = t172 + t173;
+        let t175: f32 = i2 * t56;
+        let t176: f32 = i2 * t59;
+        let t177: f32 = t4 * t25;
+        let t178: f32 = t4 * t27;
+        let t179: f32 = t14 * t25 * t101;
+        let t180: f32 = t14 * t101 * t27;
+        let t181: f32 = t14 * t25 * t102;
+        let t182: f32 = t180 + t181;
+        let t183: f32 = t175 + t177 + t179;
+        let t184: f32 = t176 + t178 + t182;
+        let t185: f32 = t68 * t183;
+        let t186: f32 = t183 * t69;
+        let t187: f32 = t68 * t184;
+        let t188: f32 = t186 + t187;
+        let t189: f32 = 1f32 + t185;
+        let t190: f32 = i14 * t189;
+        let t191: f32 = t189 * i24;
+        let t192: f32 = i14 * t188;
+        let t193: f32 = t191 + t192;
+        let t194: f32 = -(i12 * t167);
+        let t195: f32 = -(t167 * i22);
+        let t196: f32 = -(i12 * t170);
+        let t197: f32 = t195 + t196;
+        let t198: f32 = t42 * t167;
+        let t199: f32 = t167 * t45;
+        let t200: f32 = t42 * t170;
+        let t201: f32 = t199 + t200;
+        let t202: f32 = t194 + t198;
+        let t203: f32 = t197 + t201;
+        let t204: f32 = t3 * t202;
+        let t205: f32 = t3 * t203;
+        let t206: f32 = t171 + t190 + t204;
+        let t207: f32 = t174 + t193 + t205;
+        let o0: f32 = t18;
+        let o5: f32 = t19;
+        let o1: f32 = t52;
+        let o6: f32 = t53;
+        let o2: f32 = t128;
+        let o7: f32 = t129;
+        let o3: f32 = t165;
+        let o8: f32 = t166;
+        let o4: f32 = t206;
+        let o9: f32 = t207;
+        ([o0, o1, o2, o3, o4], [o5, o6, o7, o8, o9])
     }
 }
