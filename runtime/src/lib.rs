@@ -20,6 +20,7 @@
 
 pub mod dynamics;
 pub mod linalg;
+pub mod saltation;
 pub mod simulate;
 pub mod taylor;
 
