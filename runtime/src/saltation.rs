@@ -126,7 +126,8 @@ pub fn saltation<M: Surfaces<N>, const N: usize>(
     let df = m.normal(wall, q);
     let sigma = linalg::dot(&df, v_minus);
     let size2 = linalg::dot(&df, &df) * linalg::dot(v_minus, v_minus);
-    if !(sigma * sigma > 1e-18 * size2) {
+    let clear = sigma * sigma > 1e-18 * size2; // false for NaN too
+    if !clear {
         return Err(SaltationError::Grazing {
             normal_velocity: sigma,
         });
@@ -147,10 +148,10 @@ pub fn saltation<M: Surfaces<N>, const N: usize>(
     let mut matrix = StateMatrix::identity();
     matrix.vq = cq;
     matrix.vv = cv;
-    for i in 0..N {
-        for j in 0..N {
-            matrix.qq[i][j] += w_q[i] * df[j] / sigma;
-            matrix.vq[i][j] += w_v[i] * df[j] / sigma;
+    for (i, (qq, vq)) in matrix.qq.iter_mut().zip(&mut matrix.vq).enumerate() {
+        for (j, d) in df.iter().enumerate() {
+            qq[j] += w_q[i] * d / sigma;
+            vq[j] += w_v[i] * d / sigma;
         }
     }
     Ok(Saltation {
