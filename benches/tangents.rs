@@ -1,0 +1,69 @@
+//! The cost of derivatives: for q̈ and a wall's collision map of
+//! `ball_wall_euler`, `chain_3` and `chain_8`, side by side in one run,
+//!
+//! - `value`: the function itself (`closed_form_accelerations`, `collide`);
+//! - `tangent`: the value and its derivative along one direction
+//!   (`accelerations_tangent`, `collide_tangent`);
+//! - `jacobian`: the whole Jacobian by 2N (resp. Q + N) tangents
+//!   (`accelerations_jacobian`, `collide_jacobian`).
+//!
+//! The tangent's value is checked equal to the function's first. Time is
+//! the thread's CPU time. Run: `cargo bench --bench tangents`.
+
+use std::hint::black_box;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use dalembert::runtime::prelude::*;
+
+#[path = "common/cpu_time.rs"]
+mod cpu_time;
+use cpu_time::ThreadCpuTime;
+
+fn one<M: Surfaces<N> + Default, const N: usize>(c: &mut Criterion<ThreadCpuTime>) {
+    let m = M::default();
+    let q = m.initial_coordinates();
+    let v: [f64; N] = std::array::from_fn(|i| 0.3 - 0.1 * i as f64);
+    let (dq, dv): ([f64; N], [f64; N]) = (
+        std::array::from_fn(|i| 0.1 * i as f64 - 0.2),
+        std::array::from_fn(|i| 1.0 - 0.05 * i as f64),
+    );
+    let w = m.walls()[0];
+    let a = m.closed_form_accelerations(&q, &v).unwrap();
+    assert_eq!(m.accelerations_tangent(&q, &v, &dq, &dv).unwrap().0, a);
+    let after = m.collide(w, &q, &v);
+    assert_eq!(m.collide_tangent(w, &q, &v, &dq, &dv).unwrap().0, after);
+    let mut g = c.benchmark_group(format!("tangents/{}", m.name()));
+    g.bench_function("accelerations/value", |b| {
+        b.iter(|| m.closed_form_accelerations(black_box(&q), black_box(&v)))
+    });
+    g.bench_function("accelerations/tangent", |b| {
+        b.iter(|| m.accelerations_tangent(black_box(&q), black_box(&v), &dq, &dv))
+    });
+    g.bench_function("accelerations/jacobian", |b| {
+        b.iter(|| m.accelerations_jacobian(black_box(&q), black_box(&v)))
+    });
+    g.bench_function("collide/value", |b| {
+        b.iter(|| m.collide(w, black_box(&q), black_box(&v)))
+    });
+    g.bench_function("collide/tangent", |b| {
+        b.iter(|| m.collide_tangent(w, black_box(&q), black_box(&v), &dq, &dv))
+    });
+    g.bench_function("collide/jacobian", |b| {
+        b.iter(|| m.collide_jacobian(w, black_box(&q), black_box(&v)))
+    });
+    g.finish();
+}
+
+fn models(c: &mut Criterion<ThreadCpuTime>) {
+    use dalembert::models::*;
+    one::<BallWallEuler, 5>(c);
+    one::<Chain3, 3>(c);
+    one::<Chain8, 8>(c);
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().with_measurement(ThreadCpuTime);
+    targets = models
+}
+criterion_main!(benches);
