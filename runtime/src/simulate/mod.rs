@@ -68,10 +68,12 @@ mod roots;
 mod series;
 pub mod thresholds;
 mod types;
+mod variational;
 
 pub use integrator::{DormandPrince, Integrator, Rk4, Taylor};
 pub use projection::{admissible, residual};
 pub use types::{Collision, Residual, Settings, SimError, State, Stats, Step};
+pub use variational::{Variational, VariationalError};
 
 use crate::Surfaces;
 use crate::dynamics::{accelerations, qdd};
