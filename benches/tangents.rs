@@ -7,6 +7,9 @@
 //! - `jacobian`: the whole Jacobian by 2N (resp. Q + N) tangents
 //!   (`accelerations_jacobian`, `collide_jacobian`).
 //!
+//! And §3.2.1's bounce through 100 bounces with and without Φ followed
+//! (`simulate::Variational`, rtol 1e-10).
+//!
 //! The tangent's value is checked equal to the function's first. Time is
 //! the thread's CPU time. Run: `cargo bench --bench tangents`.
 
@@ -54,6 +57,41 @@ fn one<M: Surfaces<N> + Default, const N: usize>(c: &mut Criterion<ThreadCpuTime
     g.finish();
 }
 
+/// §3.2.1's bounce (`ball_bounce` from its file's start) through 100
+/// bounces by Dormand–Prince, alone and with Φ followed after every step.
+fn variational(c: &mut Criterion<ThreadCpuTime>) {
+    use dalembert::models::BallBounce;
+    use dalembert::runtime::simulate::{Simulator, State, Variational};
+    let m = BallBounce::default();
+    let start = State {
+        t: 0.0,
+        q: m.initial_coordinates(),
+        v: m.initial_velocities(),
+    };
+    let run = |follow: bool| {
+        let mut sim = Simulator::new(&m, start, Default::default()).unwrap();
+        let mut phi = Variational::new(1e-10);
+        let mut bounces = 0;
+        while bounces < 100 {
+            let step = sim.step(f64::INFINITY).unwrap();
+            bounces += step.collision.is_some() as usize;
+            if follow {
+                phi.follow(&sim, &step).unwrap();
+            }
+        }
+        (*sim.state(), *phi.matrix())
+    };
+    assert_eq!(
+        run(false).0,
+        run(true).0,
+        "following Φ leaves the run alone"
+    );
+    let mut g = c.benchmark_group("variational/ball_bounce_100_bounces");
+    g.bench_function("run", |b| b.iter(|| run(black_box(false))));
+    g.bench_function("run_and_phi", |b| b.iter(|| run(black_box(true))));
+    g.finish();
+}
+
 fn models(c: &mut Criterion<ThreadCpuTime>) {
     use dalembert::models::*;
     one::<BallWallEuler, 5>(c);
@@ -64,6 +102,6 @@ fn models(c: &mut Criterion<ThreadCpuTime>) {
 criterion_group! {
     name = benches;
     config = Criterion::default().with_measurement(ThreadCpuTime);
-    targets = models
+    targets = models, variational
 }
 criterion_main!(benches);
