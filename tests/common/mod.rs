@@ -128,47 +128,15 @@ pub fn in_child(test: &str, ignored: bool, env: &[(&str, &std::ffi::OsStr)]) {
 }
 
 /// A random direction (δq, δv) tangent to the constraint manifold at
-/// (q, v): the holonomic rows of A(q) (its first rows) vanish on δq, and
-/// A(q) δv + (∂A/∂q δq) v = 0, the latter's derivative taken by central
-/// differences. `None` where the rows cannot be solved.
+/// (q, v) (`simulate::tangent_direction` of a random one). `None` where
+/// the rows cannot be solved.
 pub fn admissible_direction<M: Dynamics<N>, const N: usize>(
     m: &M,
     q: &[f64; N],
     v: &[f64; N],
     seed: &mut u64,
 ) -> Option<([f64; N], [f64; N])> {
-    let identity: [[f64; N]; N] =
-        std::array::from_fn(|i| std::array::from_fn(|j| (i == j) as u8 as f64));
-    let remove = |rows: &[[f64; N]], x: [f64; N], r: &[f64]| -> Option<[f64; N]> {
-        if rows.is_empty() {
-            return Some(x);
-        }
-        let d = dalembert::runtime::linalg::correction(&identity, rows, r).ok()?;
-        Some(std::array::from_fn(|i| x[i] - d[i]))
-    };
-    let a = m.constraints(q);
-    let holonomic = &a.as_slice()[..m.holonomic(q).as_slice().len()];
-    let dq0: [f64; N] = std::array::from_fn(|_| lcg(seed) - 0.5);
-    let r: Vec<f64> = holonomic
-        .iter()
-        .map(|row| dalembert::runtime::linalg::dot(row, &dq0))
-        .collect();
-    let dq = remove(holonomic, dq0, &r)?;
-    let eps = 1e-6;
-    let along = |s: f64| -> Vec<f64> {
-        let q: [f64; N] = std::array::from_fn(|i| q[i] + s * dq[i]);
-        m.constraints(&q)
-            .as_slice()
-            .iter()
-            .map(|row| dalembert::runtime::linalg::dot(row, v))
-            .collect()
-    };
-    let (plus, minus) = (along(eps), along(-eps));
-    let dv0: [f64; N] = std::array::from_fn(|_| lcg(seed) - 0.5);
-    let r: Vec<f64> = (a.as_slice().iter().enumerate())
-        .map(|(k, row)| {
-            dalembert::runtime::linalg::dot(row, &dv0) + (plus[k] - minus[k]) / (2.0 * eps)
-        })
-        .collect();
-    Some((dq, remove(a.as_slice(), dv0, &r)?))
+    let dq: [f64; N] = std::array::from_fn(|_| lcg(seed) - 0.5);
+    let dv: [f64; N] = std::array::from_fn(|_| lcg(seed) - 0.5);
+    dalembert::runtime::simulate::tangent_direction(m, q, v, &dq, &dv).ok()
 }

@@ -12,7 +12,7 @@ use dalembert::models::*;
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
     DormandPrince, Integrator, Residual, Rk4, Settings, SimError, Simulator, State, Taylor,
-    admissible, residual,
+    Variational, VariationalError, admissible, residual, tangent_direction,
 };
 use dalembert::runtime::taylor::MAX_ORDER;
 use dalembert_codegen::Derivation;
@@ -84,6 +84,14 @@ pub struct SimulateArgs {
     /// Directory for `<model>.csv` and `<model>.svg`.
     #[arg(long, default_value = "target/simulate")]
     pub out: PathBuf,
+    /// Also follow Φ = ∂x(t)/∂x(0), x = (q, q̇), through the collisions
+    /// (at `--rtol`) and report how the perturbation of every coordinate
+    /// and velocity by the same amount, moved onto the directions the
+    /// constraints allow, has grown at the end: |Φ δx₀|/|δx₀| and its rate
+    /// ln(|Φ δx₀|/|δx₀|)/t (a finite-time Lyapunov estimate). Slower: Φ's
+    /// 2N columns are integrated along every step.
+    #[arg(long)]
+    pub sensitivity: bool,
 }
 
 /// The built-in models with coordinates, for `--help`.
@@ -319,11 +327,21 @@ fn run<M: Surfaces<N>, const N: usize>(
     );
     let clock = Instant::now();
     let dense = matches!(args.integrator, Method::Taylor);
-    let failure = integrate(&mut sim, &model, (args.t_end, every, dense), &mut out)?;
+    let mut phi = args.sensitivity.then(|| Variational::new(args.rtol));
+    let failure = integrate(
+        &mut sim,
+        &model,
+        (args.t_end, every, dense),
+        &mut out,
+        phi.as_mut(),
+    )?;
     let elapsed = clock.elapsed();
     out.finish()?;
     plot(&svg, &model, &out.kept, path, e0)?;
     summary(&sim, &model, args, &out, e0, elapsed.as_secs_f64());
+    if let Some(phi) = &phi {
+        sensitivity(&model, &start, sim.state().t, phi)?;
+    }
     println!("  trajectory: {} ({} rows)", csv.display(), out.written);
     println!("  plot:       {}", svg.display());
     match failure {
@@ -435,6 +453,7 @@ fn integrate<'m, M: Surfaces<N>, const N: usize>(
     model: &'m M,
     (t_end, every, dense): (f64, f64, bool),
     out: &mut Output<'m, N>,
+    mut phi: Option<&mut Variational<N>>,
 ) -> Result<Option<String>, String> {
     let bar = ProgressBar::new(1000);
     bar.set_style(
@@ -457,6 +476,22 @@ fn integrate<'m, M: Surfaces<N>, const N: usize>(
                 break;
             }
         };
+        if let Some(phi) = phi.as_deref_mut()
+            && let Err(e) = phi.follow(sim, &step)
+        {
+            let e = match e {
+                VariationalError::Saltation { wall, error } => {
+                    format!("at the collision with `{}`: {error}", model.wall_name(wall))
+                }
+                VariationalError::NoDerivative => {
+                    "the model has no derivative of q̈ (no closed form or elimination written out)"
+                        .to_string()
+                }
+                other => format!("{other:?}"),
+            };
+            failure = Some(format!("Φ could not follow the run: {e}"));
+            break;
+        }
         // Rows strictly inside the step (before its collision, if any);
         // none where the step stopped at the next row.
         let stop = step.collision.as_ref().map_or(step.state.t, |c| c.t);
@@ -549,6 +584,26 @@ fn summary<M: Surfaces<N>, const N: usize>(
         "  largest constraint residuals over the rows: |A q̇| = {:.2e}, |h(q)| = {:.2e}",
         out.worst[0], out.worst[1]
     );
+}
+
+/// The growth of the perturbation of every coordinate and velocity by the
+/// same amount, moved onto the admissible directions at the start.
+fn sensitivity<M: Surfaces<N>, const N: usize>(
+    model: &M,
+    start: &State<N>,
+    t: f64,
+    phi: &Variational<N>,
+) -> Result<(), String> {
+    let (dq, dv) = tangent_direction(model, &start.q, &start.v, &[1.0; N], &[1.0; N])
+        .map_err(|e| format!("no admissible perturbation at the start: {e:?}"))?;
+    let size = |q: &[f64; N], v: &[f64; N]| q.iter().chain(v).map(|x| x * x).sum::<f64>().sqrt();
+    let (pq, pv) = phi.matrix().apply(&dq, &dv);
+    let growth = size(&pq, &pv) / size(&dq, &dv);
+    println!(
+        "  sensitivity: |Φ δx₀|/|δx₀| = {growth:.6e} at t = {t} (δx₀: every coordinate and velocity +1, made admissible); rate ln(·)/t = {:.6e}",
+        growth.ln() / t
+    );
+    Ok(())
 }
 
 /// Indices of the two coordinates drawn as the path.

@@ -71,7 +71,7 @@ mod types;
 mod variational;
 
 pub use integrator::{DormandPrince, Integrator, Rk4, Taylor};
-pub use projection::{admissible, residual};
+pub use projection::{admissible, residual, tangent_direction};
 pub use types::{Collision, Residual, Settings, SimError, State, Stats, Step};
 pub use variational::{Variational, VariationalError};
 

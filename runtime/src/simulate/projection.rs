@@ -88,3 +88,51 @@ pub fn admissible<M: Dynamics<N>, const N: usize>(
     let d = linalg::correction(&m.mass_matrix(q), a.as_slice(), a.apply(v).as_slice())?;
     Ok(core::array::from_fn(|i| v[i] - d[i]))
 }
+
+/// A perturbation (δq, δv) of the state (q, v) moved onto the directions a
+/// motion can take, tangent to the constraint manifold: δq onto the kernel
+/// of the holonomic rows of A(q) (its first rows), then δv so that
+/// A(q) δv + (∂A/∂q δq) v = 0, both the smallest change in the metric of
+/// G(q); ∂A/∂q δq by a central difference of A along δq. A perturbation
+/// of a start along such a direction stays admissible to first order, so
+/// [`crate::simulate::Variational`]'s Φ applied to it is the simulation's
+/// derivative.
+pub fn tangent_direction<M: Dynamics<N>, const N: usize>(
+    m: &M,
+    q: &[f64; N],
+    v: &[f64; N],
+    dq: &[f64; N],
+    dv: &[f64; N],
+) -> Result<([f64; N], [f64; N]), ProjectorError> {
+    let a = m.constraints(q);
+    if a.is_empty() {
+        return Ok((*dq, *dv));
+    }
+    let g = m.mass_matrix(q);
+    let holonomic = &a.as_slice()[..m.holonomic(q).as_slice().len()];
+    let mut dq = *dq;
+    if !holonomic.is_empty() {
+        let r: [f64; N] =
+            core::array::from_fn(|k| holonomic.get(k).map_or(0.0, |row| linalg::dot(row, &dq)));
+        let d = linalg::correction(&g, holonomic, &r[..holonomic.len()])?;
+        dq = core::array::from_fn(|i| dq[i] - d[i]);
+    }
+    // (∂A/∂q δq) v, zero where δq is.
+    let size = norm(&dq);
+    let mut moved = [0.0; N];
+    if size > 0.0 {
+        let eps = 1e-6 * (1.0 + norm(q)) / size;
+        let along = |s: f64| {
+            let q: [f64; N] = core::array::from_fn(|i| q[i] + s * dq[i]);
+            m.constraints(&q).apply(v)
+        };
+        let (plus, minus) = (along(eps), along(-eps));
+        for (k, x) in moved.iter_mut().enumerate().take(a.len()) {
+            *x = (plus.as_slice()[k] - minus.as_slice()[k]) / (2.0 * eps);
+        }
+    }
+    let av = a.apply(dv);
+    let r: [f64; N] = core::array::from_fn(|k| av.as_slice().get(k).map_or(0.0, |x| x + moved[k]));
+    let d = linalg::correction(&g, a.as_slice(), &r[..a.len()])?;
+    Ok((dq, core::array::from_fn(|i| dv[i] - d[i])))
+}
