@@ -87,3 +87,32 @@ fn generated_code_has_a_bounded_size() {
         "{stderr}"
     );
 }
+
+/// A dense model of 30 coordinates is within the bound, but not with its
+/// tangents (about three times q̈'s and the map's code): it generates
+/// without them, and its header says so.
+#[test]
+fn tangents_past_the_bound_are_left_out() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("generate");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("dense_30.toml");
+    std::fs::write(&file, dense(30)).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_dalembert"))
+        .arg("generate")
+        .arg(&file)
+        .output()
+        .expect("the CLI runs");
+    let code = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        code.contains("//   tangents                     left out: they would add "),
+        "{}",
+        &code[..code.len().min(2000)]
+    );
+    assert!(code.contains("pub fn accelerations("));
+    assert!(!code.contains("accelerations_tangent"));
+}

@@ -148,7 +148,7 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
     functions.push(initial_state(&sym, &compile, cx)?);
     let mut functions = functions.into_iter().flatten().collect();
     let mut walls = walls;
-    tangents(&mut functions, &mut walls, sym.params.len());
+    let tangents_left_out = tangents(&mut functions, &mut walls, sym.params.len());
     Ok(Derivation {
         model: model.clone(),
         mass_matrix: strings(&exact.g),
@@ -157,6 +157,7 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
         accelerations: accelerations.map(|x| x.iter().map(|a| a.to_string()).collect()),
         walls,
         functions,
+        tangents_left_out,
         motion_systems,
     })
 }
@@ -164,32 +165,53 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
 /// Pass 6: the tangent functions, q̈'s and each collision map's program
 /// differentiated forward along the phase (the inputs after the
 /// `params` parameters), each placed after the function it differentiates.
-fn tangents(functions: &mut Vec<Function>, walls: &mut [WallDerivation], params: usize) {
-    let tangent = |list: &mut Vec<Function>, of: Quantity, quantity: Quantity| {
-        if let Some(i) = list.iter().position(|f| f.quantity == of) {
-            let program = list[i].program.tangent(params);
-            list.insert(
-                i + 1,
-                Function {
-                    quantity,
-                    program,
-                    rows: 0,
-                },
-            );
-        }
+/// They are about three times the code of what they differentiate: where
+/// they would take the model past [`crate::MAX_GENERATED_INSTRUCTIONS`]
+/// they are left out (the model then has no derivatives, and its header
+/// says why; a model past the bound without them is refused as before),
+/// and the number of instructions they would have added is returned.
+fn tangents(
+    functions: &mut Vec<Function>,
+    walls: &mut [WallDerivation],
+    params: usize,
+) -> Option<usize> {
+    let tangent = |list: &[Function], of: Quantity, quantity: Quantity| {
+        let i = list.iter().position(|f| f.quantity == of)?;
+        let program = list[i].program.tangent(params);
+        Some((
+            i + 1,
+            Function {
+                quantity,
+                program,
+                rows: 0,
+            },
+        ))
     };
-    tangent(
+    let model = tangent(
         functions,
         Quantity::Accelerations,
         Quantity::AccelerationsTangent,
     );
-    for w in walls {
-        tangent(
-            &mut w.functions,
-            Quantity::Collide,
-            Quantity::CollideTangent,
-        );
+    let per_wall: Vec<_> = (walls.iter())
+        .map(|w| tangent(&w.functions, Quantity::Collide, Quantity::CollideTangent))
+        .collect();
+    let size = |fs: &[Function]| fs.iter().map(|f| f.program.instrs.len()).sum::<usize>();
+    let now = size(functions) + walls.iter().map(|w| size(&w.functions)).sum::<usize>();
+    let added: usize = (model.iter().chain(per_wall.iter().flatten()))
+        .map(|(_, f)| f.program.instrs.len())
+        .sum();
+    if now + added > crate::MAX_GENERATED_INSTRUCTIONS {
+        return Some(added);
     }
+    if let Some((i, f)) = model {
+        functions.insert(i, f);
+    }
+    for (w, t) in walls.iter_mut().zip(per_wall) {
+        if let Some((i, f)) = t {
+            w.functions.insert(i, f);
+        }
+    }
+    None
 }
 
 /// The `[initial]` state as a function of the parameters, so that it

@@ -26,6 +26,10 @@ pub struct Derivation {
     /// The model-wide emitted functions, in [`crate::quantity::TABLE`]
     /// order.
     pub functions: Vec<Function>,
+    /// Where the tangent functions were left out (they would have taken
+    /// the model's code past [`crate::MAX_GENERATED_INSTRUCTIONS`]): the
+    /// instructions they would have added.
+    pub tangents_left_out: Option<usize>,
     /// Where q̈ is written out by elimination: the system it solves; and
     /// without constraints, closed form or not, G q̈ = −h and the same
     /// motion as the momentum's, for Taylor's method to solve per order.

@@ -122,6 +122,13 @@ fn header(d: &Ctx) -> String {
             "//   {what:<28} structured: solved at run time from G and B\n"
         ));
     }
+    if let Some(added) = d.derivation.tangents_left_out {
+        h.push_str(&format!(
+            "//   {:<28} left out: they would add {added} instructions, past the bound of {}\n",
+            "tangents",
+            crate::MAX_GENERATED_INSTRUCTIONS
+        ));
+    }
     if let Some((motion, walls)) = d.series() {
         h.push_str("//\n// Taylor series, per order (series operations, of them convolutions):\n");
         let work = motion.work();
