@@ -143,12 +143,7 @@ fn saltation_matches_differences_of_the_flow_through_a_collision() {
                     let ((q, v), t) = through(&m, wall, k, (q, v), t_end);
                     [q[0], q[1], v[0], v[1], t]
                 };
-                let central = |h: f64| -> [f64; 5] {
-                    let (a, b) = (shifted(h), shifted(-h));
-                    std::array::from_fn(|i| (a[i] - b[i]) / (2.0 * h))
-                };
-                let (coarse, fine) = (central(1e-4), central(5e-5));
-                let fd: [f64; 5] = std::array::from_fn(|i| (4.0 * fine[i] - coarse[i]) / 3.0);
+                let fd = common::richardson(|h| shifted(h).to_vec(), 1e-4);
                 let mut unit = ([0.0; 2], [0.0; 2]);
                 if j < 2 {
                     unit.0[j] = 1.0

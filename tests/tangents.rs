@@ -32,22 +32,8 @@ const TOL: f64 = 1e-8;
 /// result's error: its distance from the same at step h/4 (a wall's map
 /// near its centre of curvature changes on a scale of |q|, where a fixed
 /// step's error is no longer small).
-fn richardson(f: impl Fn(f64) -> Vec<f64>, h: f64) -> (Vec<f64>, Vec<f64>) {
-    let central = |h: f64| -> Vec<f64> {
-        let (plus, minus) = (f(h), f(-h));
-        plus.iter()
-            .zip(&minus)
-            .map(|(a, b)| (a - b) / (2.0 * h))
-            .collect()
-    };
-    let extrapolated = |h: f64| -> Vec<f64> {
-        let (coarse, fine) = (central(h), central(h / 2.0));
-        fine.iter()
-            .zip(&coarse)
-            .map(|(f, c)| (4.0 * f - c) / 3.0)
-            .collect()
-    };
-    let (rough, fine) = (extrapolated(h), extrapolated(h / 4.0));
+fn differences(f: impl Fn(f64) -> Vec<f64>, h: f64) -> (Vec<f64>, Vec<f64>) {
+    let (rough, fine) = (common::richardson(&f, h), common::richardson(&f, h / 4.0));
     let error = fine
         .iter()
         .zip(&rough)
@@ -119,7 +105,7 @@ fn accelerations_by_differences<M: Dynamics<N>, const N: usize>(
         let column: Vec<f64> = (0..N)
             .map(|i| if j < N { by_q[i][j] } else { by_v[i][j - N] })
             .collect();
-        let fd = richardson(
+        let fd = differences(
             |s| {
                 let (q, v) = moved(q, &v, j, s);
                 m.closed_form_accelerations(&q, &v).unwrap().to_vec()
@@ -154,7 +140,7 @@ fn collisions<M: Walls<Q, N>, const Q: usize, const N: usize>(
             let column: Vec<f64> = (0..N)
                 .map(|i| if j < Q { by_q[i][j] } else { by_v[i][j - Q] })
                 .collect();
-            let fd = richardson(
+            let fd = differences(
                 |s| {
                     let (mut q, mut v) = (*q, v);
                     if j < Q {
@@ -207,7 +193,7 @@ fn against_numeric_solves<M: Surfaces<N>, const N: usize>(
         let Ok(numeric) = accelerations(m, q, &v) else {
             return Ok(());
         };
-        let fd = richardson(
+        let fd = differences(
             |s| {
                 let (q, v) = at(s);
                 accelerations(m, &q, &v).map_or(vec![f64::NAN; N], |x| x.qdd.to_vec())
@@ -244,7 +230,7 @@ fn against_numeric_solves<M: Surfaces<N>, const N: usize>(
                     (0..N).map(|i| v[i] - 2.0 * d[i]).collect()
                 })
         };
-        let fd = richardson(
+        let fd = differences(
             |s| {
                 let (q, v) = at(s);
                 solve(&q, &v)

@@ -177,16 +177,7 @@ fn check<M: Surfaces<N>, const N: usize>(m: &M, x0: ([f64; N], [f64; N]), t_end:
                 );
                 x.q.iter().chain(&x.v).copied().collect()
             };
-            let central = |h: f64| -> Vec<f64> {
-                let (a, b) = (at(h), at(-h));
-                a.iter().zip(&b).map(|(a, b)| (a - b) / (2.0 * h)).collect()
-            };
-            let (coarse, fine) = (central(2.0 * eps), central(eps));
-            let fd: Vec<f64> = fine
-                .iter()
-                .zip(&coarse)
-                .map(|(f, c)| (4.0 * f - c) / 3.0)
-                .collect();
+            let fd = common::richardson(at, 2.0 * eps);
             let got: Vec<f64> = pq.iter().chain(&pv).copied().collect();
             let scale = fd.iter().fold(1.0_f64, |a, x| a.max(x.abs()));
             let worst = got

@@ -140,3 +140,20 @@ pub fn admissible_direction<M: Dynamics<N>, const N: usize>(
     let dv: [f64; N] = std::array::from_fn(|_| lcg(seed) - 0.5);
     dalembert::runtime::simulate::tangent_direction(m, q, v, &dq, &dv).ok()
 }
+
+/// The derivative of `f` at 0 by central differences with steps h and h/2,
+/// combined by one Richardson step (error O(h⁴)).
+pub fn richardson(f: impl Fn(f64) -> Vec<f64>, h: f64) -> Vec<f64> {
+    let central = |h: f64| -> Vec<f64> {
+        let (plus, minus) = (f(h), f(-h));
+        plus.iter()
+            .zip(&minus)
+            .map(|(a, b)| (a - b) / (2.0 * h))
+            .collect()
+    };
+    let (coarse, fine) = (central(h), central(h / 2.0));
+    fine.iter()
+        .zip(&coarse)
+        .map(|(f, c)| (4.0 * f - c) / 3.0)
+        .collect()
+}

@@ -12,7 +12,7 @@ use dalembert::models::*;
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
     DormandPrince, Integrator, Residual, Rk4, Settings, SimError, Simulator, State, Taylor,
-    Variational, VariationalError, admissible, residual, tangent_direction,
+    Variational, admissible, residual,
 };
 use dalembert::runtime::taylor::MAX_ORDER;
 use dalembert_codegen::Derivation;
@@ -22,6 +22,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use crate::plot::plot;
 
 mod output;
+mod sensitivity;
 pub use output::Row;
 use output::{MAX_ROWS, Output};
 
@@ -340,7 +341,7 @@ fn run<M: Surfaces<N>, const N: usize>(
     plot(&svg, &model, &out.kept, path, e0)?;
     summary(&sim, &model, args, &out, e0, elapsed.as_secs_f64());
     if let Some(phi) = &phi {
-        sensitivity(&model, &start, sim.state().t, phi)?;
+        sensitivity::report(&model, &start, sim.state().t, phi)?;
     }
     println!("  trajectory: {} ({} rows)", csv.display(), out.written);
     println!("  plot:       {}", svg.display());
@@ -479,17 +480,7 @@ fn integrate<'m, M: Surfaces<N>, const N: usize>(
         if let Some(phi) = phi.as_deref_mut()
             && let Err(e) = phi.follow(sim, &step)
         {
-            let e = match e {
-                VariationalError::Saltation { wall, error } => {
-                    format!("at the collision with `{}`: {error}", model.wall_name(wall))
-                }
-                VariationalError::NoDerivative => {
-                    "the model has no derivative of q̈ (no closed form or elimination written out)"
-                        .to_string()
-                }
-                other => format!("{other:?}"),
-            };
-            failure = Some(format!("Φ could not follow the run: {e}"));
+            failure = Some(sensitivity::failure(model, e));
             break;
         }
         // Rows strictly inside the step (before its collision, if any);
@@ -584,26 +575,6 @@ fn summary<M: Surfaces<N>, const N: usize>(
         "  largest constraint residuals over the rows: |A q̇| = {:.2e}, |h(q)| = {:.2e}",
         out.worst[0], out.worst[1]
     );
-}
-
-/// The growth of the perturbation of every coordinate and velocity by the
-/// same amount, moved onto the admissible directions at the start.
-fn sensitivity<M: Surfaces<N>, const N: usize>(
-    model: &M,
-    start: &State<N>,
-    t: f64,
-    phi: &Variational<N>,
-) -> Result<(), String> {
-    let (dq, dv) = tangent_direction(model, &start.q, &start.v, &[1.0; N], &[1.0; N])
-        .map_err(|e| format!("no admissible perturbation at the start: {e:?}"))?;
-    let size = |q: &[f64; N], v: &[f64; N]| q.iter().chain(v).map(|x| x * x).sum::<f64>().sqrt();
-    let (pq, pv) = phi.matrix().apply(&dq, &dv);
-    let growth = size(&pq, &pv) / size(&dq, &dv);
-    println!(
-        "  sensitivity: |Φ δx₀|/|δx₀| = {growth:.6e} at t = {t} (δx₀: every coordinate and velocity +1, made admissible); rate ln(·)/t = {:.6e}",
-        growth.ln() / t
-    );
-    Ok(())
 }
 
 /// Indices of the two coordinates drawn as the path.
