@@ -20,6 +20,8 @@
 
 pub mod dynamics;
 pub mod linalg;
+#[cfg(feature = "periodic")]
+pub mod periodic;
 pub mod saltation;
 pub mod simulate;
 pub mod taylor;

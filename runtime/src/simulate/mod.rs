@@ -64,6 +64,7 @@ mod events;
 pub mod integrator;
 mod phase;
 mod projection;
+mod return_map;
 mod roots;
 mod series;
 pub mod thresholds;
@@ -72,6 +73,7 @@ mod variational;
 
 pub use integrator::{DormandPrince, Integrator, Rk4, Taylor};
 pub use projection::{admissible, residual, tangent_direction};
+pub use return_map::{Return, ReturnError, Section, return_map};
 pub use types::{Collision, Residual, Settings, SimError, State, Stats, Step};
 pub use variational::{Variational, VariationalError};
 

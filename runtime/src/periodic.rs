@@ -1,0 +1,437 @@
+//! Periodic orbits through collisions and their Floquet multipliers
+//! (feature `periodic`: dense linear algebra from nalgebra, on the heap).
+//!
+//! An orbit is sought as a fixed point of a wall's return map Π
+//! ([`return_map`]): a state x₀ just after a collision with the wall from
+//! which the motion comes back to x₀ at its `returns`-th collision with it.
+//! Newton's method solves Π(x₀) = x₀ over the states x₀ + Zξ, Z an
+//! orthonormal basis of the perturbations along the section that the
+//! constraints allow (tangent to h(q) = 0, A(q)q̇ = 0 and f(q) = 0): each
+//! step is the least-squares solution of (DΠ − I)Zξ = x₀ − Π(x₀) of
+//! smallest norm, singular values below a fraction [`Search::cutoff`] of the
+//! largest taken as zero. Orbits of conservative systems come in families
+//! (other energies, translations along a floor, the attitude of a ball), so
+//! DΠ − I is singular on the orbit: the smallest-norm step moves to the
+//! nearest member of the family instead of failing. A step that does not
+//! lower the residual is halved, up to [`Search::halvings`] times. After
+//! each step the state is put back on the section and the constraints:
+//! q onto h(q) = 0 and f(q) = 0 (Gauss–Newton, smallest change in the
+//! metric of G), q̇ onto ker A(q).
+//!
+//! The Floquet multipliers are the eigenvalues of Zᵀ DΠ Z at the orbit:
+//! the monodromy restricted to the section and the constraint manifold
+//! (the flow's own direction, whose multiplier is always 1, is not in
+//! it). Every family and symmetry adds multipliers equal to 1.
+
+extern crate alloc;
+
+use alloc::vec::Vec;
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::Surfaces;
+use crate::linalg::{self, ProjectorError};
+use crate::saltation::StateMatrix;
+use crate::simulate::{
+    Return, ReturnError, Section, Settings, Simulator, State, admissible, return_map,
+    tangent_direction,
+};
+
+/// How an orbit is searched for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Search {
+    /// The simulator's settings for every evaluation of Π.
+    pub settings: Settings,
+    /// Relative tolerance of Φ's integration (DΠ).
+    pub rtol: f64,
+    /// Newton's method stops when |Π(x₀) − x₀|∞ ≤ `tolerance` · max(1, |x₀|∞).
+    pub tolerance: f64,
+    /// Most Newton steps.
+    pub max_iterations: usize,
+    /// Most halvings of a step that does not lower the residual.
+    pub halvings: usize,
+    /// Singular values of (DΠ − I)Z below `cutoff` times the largest are
+    /// taken as zero.
+    pub cutoff: f64,
+    /// A multiplier within this distance of the unit circle counts as on
+    /// it (and within it of 1, as 1). Multipliers of a Jordan block are
+    /// only as accurate as the square root of DΠ's error.
+    pub unit: f64,
+}
+
+impl Default for Search {
+    fn default() -> Self {
+        Self {
+            settings: Settings::default(),
+            rtol: 1e-12,
+            tolerance: 1e-10,
+            max_iterations: 20,
+            halvings: 12,
+            cutoff: 1e-6,
+            unit: 1e-5,
+        }
+    }
+}
+
+/// A periodic orbit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Orbit<const N: usize> {
+    /// The state on the section (just after the collision), at t = 0.
+    pub state: State<N>,
+    /// The period: the time of `returns` returns.
+    pub period: f64,
+    /// The Floquet multipliers (re, im), largest modulus first.
+    pub multipliers: Vec<[f64; 2]>,
+    /// DΠ at the orbit over (q, q̇) (2N × 2N, off the section included).
+    pub monodromy: StateMatrix<N>,
+    /// |Π(x₀) − x₀|∞ / max(1, |x₀|∞) at the orbit.
+    pub residual: f64,
+    /// Newton steps taken.
+    pub iterations: usize,
+    /// Collisions in one period, with every wall.
+    pub collisions: u64,
+}
+
+/// What the multipliers say about an orbit's linear stability.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Stability {
+    /// A multiplier outside the unit circle: perturbations grow like
+    /// `largest` per period.
+    Unstable {
+        /// The largest modulus.
+        largest: f64,
+    },
+    /// Every multiplier on the unit circle (within [`Search::unit`]): no
+    /// perturbation grows or decays at the linear order, which alone
+    /// cannot decide stability.
+    Neutral,
+    /// Every multiplier inside or on the unit circle, some inside.
+    Stable {
+        /// The largest modulus of those inside.
+        largest_inside: f64,
+    },
+}
+
+/// Why no orbit was found.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PeriodicError<W> {
+    /// The start could not be brought onto the section, or a return map
+    /// could not be evaluated.
+    Return(ReturnError<W>),
+    /// Newton's method ran `iterations` steps without reaching the
+    /// tolerance; the residual it reached.
+    NoConvergence {
+        /// Steps taken.
+        iterations: usize,
+        /// The smallest residual reached.
+        residual: f64,
+    },
+    /// No step of Newton's direction, however short, lowered the residual.
+    Stalled {
+        /// Steps taken.
+        iterations: usize,
+        /// The residual it stalled at.
+        residual: f64,
+    },
+    /// (DΠ − I)Z is zero or not finite: Newton's method has no direction.
+    SingularJacobian {
+        /// Steps taken.
+        iterations: usize,
+    },
+    /// The state could not be put back on the constraints and the section.
+    Projection(ProjectorError),
+    /// The section has no perturbations the constraints allow (the wall
+    /// is tangent to the constraint manifold there).
+    NoSection,
+    /// An eigenvalue or singular value decomposition did not converge.
+    Decomposition,
+}
+
+impl<W> From<ReturnError<W>> for PeriodicError<W> {
+    fn from(e: ReturnError<W>) -> Self {
+        Self::Return(e)
+    }
+}
+
+/// The first state of the section on the motion from `start`: `start`
+/// itself if it is on the wall and moving away, else the state just after
+/// the first collision with the wall.
+pub fn onto_section<M: Surfaces<N>, const N: usize>(
+    model: &M,
+    start: State<N>,
+    section: &Section<M::Wall>,
+    settings: Settings,
+) -> Result<State<N>, ReturnError<M::Wall>> {
+    let (f, sigma) = (
+        model.surface(section.wall, &start.q),
+        model.normal_velocity(section.wall, &start.q, &start.v),
+    );
+    let scale = 1.0 + norm(&start.q);
+    if f.abs() <= 1e-12 * scale && sigma > 0.0 {
+        return Ok(start);
+    }
+    let mut sim = Simulator::new(model, start, settings).map_err(ReturnError::Simulation)?;
+    let t_end = start.t + section.t_max;
+    while sim.state().t < t_end {
+        let step = sim.step(t_end).map_err(ReturnError::Simulation)?;
+        if step.collision.is_some_and(|c| c.wall == section.wall) {
+            return Ok(State {
+                t: 0.0,
+                ..step.state
+            });
+        }
+    }
+    Err(ReturnError::NoReturn {
+        met: 0,
+        t_max: section.t_max,
+    })
+}
+
+/// Searches a periodic orbit of `section` from `start` (brought onto the
+/// section first, [`onto_section`]); see the module doc.
+pub fn find<M: Surfaces<N>, const N: usize>(
+    model: &M,
+    start: State<N>,
+    section: &Section<M::Wall>,
+    search: &Search,
+) -> Result<Orbit<N>, PeriodicError<M::Wall>> {
+    let mut x = onto_section(model, start, section, search.settings)?;
+    x.t = 0.0;
+    let residual_of = |x: &State<N>, r: &Return<N>| {
+        let scale = norm_inf(&x.q).max(norm_inf(&x.v)).max(1.0);
+        let d = difference(&r.state, x);
+        d.iter().fold(0.0_f64, |m, e| m.max(e.abs())) / scale
+    };
+    let mut iterations = 0;
+    loop {
+        let map = return_map(model, x, section, search.settings, Some(search.rtol))?;
+        let residual = residual_of(&x, &map);
+        let jacobian = map.jacobian.expect("asked for");
+        if residual <= search.tolerance {
+            let z = section_basis(model, &x, section.wall)?;
+            let multipliers = multipliers(&z, &jacobian)?;
+            return Ok(Orbit {
+                state: x,
+                period: map.state.t - x.t,
+                multipliers,
+                monodromy: jacobian,
+                residual,
+                iterations,
+                collisions: map.collisions,
+            });
+        }
+        if iterations == search.max_iterations {
+            return Err(PeriodicError::NoConvergence {
+                iterations,
+                residual,
+            });
+        }
+        iterations += 1;
+        let z = section_basis(model, &x, section.wall)?;
+        let dpi = dense(&jacobian);
+        let a = (&dpi - DMatrix::identity(2 * N, 2 * N)) * &z;
+        let r = DVector::from_vec(difference(&map.state, &x).to_vec());
+        let svd = nalgebra::linalg::SVD::try_new(a, true, true, 5.0 * f64::EPSILON, 100_000)
+            .ok_or(PeriodicError::Decomposition)?;
+        let largest = svd.singular_values.max();
+        if !(largest > 0.0 && largest.is_finite()) {
+            return Err(PeriodicError::SingularJacobian { iterations });
+        }
+        let xi = svd
+            .solve(&(-r), search.cutoff * largest)
+            .map_err(|_| PeriodicError::Decomposition)?;
+        let dx = &z * xi;
+        // Damping: the first of the step, its half, ... that lowers the
+        // residual.
+        let mut lambda = 1.0;
+        let mut accepted = None;
+        for _ in 0..=search.halvings {
+            let trial = restore(model, &x, &dx, lambda, section.wall)?;
+            if let Ok(map) = return_map(model, trial, section, search.settings, None)
+                && residual_of(&trial, &map) < residual
+            {
+                accepted = Some(trial);
+                break;
+            }
+            lambda *= 0.5;
+        }
+        x = accepted.ok_or(PeriodicError::Stalled {
+            iterations,
+            residual,
+        })?;
+    }
+}
+
+/// The linear stability the multipliers give, with `unit` the distance
+/// from the unit circle that counts as on it.
+pub fn stability(multipliers: &[[f64; 2]], unit: f64) -> Stability {
+    let modulus = |m: &[f64; 2]| libm::hypot(m[0], m[1]);
+    let largest = multipliers.iter().map(modulus).fold(0.0, f64::max);
+    if largest > 1.0 + unit {
+        return Stability::Unstable { largest };
+    }
+    let inside = multipliers
+        .iter()
+        .map(modulus)
+        .filter(|&m| m < 1.0 - unit)
+        .fold(None, |a: Option<f64>, m| Some(a.map_or(m, |a| a.max(m))));
+    match inside {
+        None => Stability::Neutral,
+        Some(largest_inside) => Stability::Stable { largest_inside },
+    }
+}
+
+/// Π(x) − x over (q, q̇).
+fn difference<const N: usize>(y: &State<N>, x: &State<N>) -> Vec<f64> {
+    let dq = y.q.iter().zip(&x.q).map(|(a, b)| a - b);
+    let dv = y.v.iter().zip(&x.v).map(|(a, b)| a - b);
+    dq.chain(dv).collect()
+}
+
+fn dense<const N: usize>(m: &StateMatrix<N>) -> DMatrix<f64> {
+    DMatrix::from_fn(2 * N, 2 * N, |i, j| {
+        let block = match (i < N, j < N) {
+            (true, true) => &m.qq,
+            (true, false) => &m.qv,
+            (false, true) => &m.vq,
+            (false, false) => &m.vv,
+        };
+        block[i % N][j % N]
+    })
+}
+
+/// An orthonormal basis (columns, Euclidean in (q, q̇)) of the
+/// perturbations at x tangent to the constraint manifold and to the
+/// wall's section: the range of the admissible-direction projection
+/// ([`tangent_direction`]) with df·δq = 0.
+fn section_basis<M: Surfaces<N>, const N: usize>(
+    model: &M,
+    x: &State<N>,
+    wall: M::Wall,
+) -> Result<DMatrix<f64>, PeriodicError<M::Wall>> {
+    let mut columns = DMatrix::zeros(2 * N, 2 * N);
+    for j in 0..2 * N {
+        let unit = |k: usize| core::array::from_fn(|i| f64::from(u8::from(i + k == j)));
+        let (dq, dv) = tangent_direction(model, &x.q, &x.v, &unit(0), &unit(N))
+            .map_err(PeriodicError::Projection)?;
+        for i in 0..N {
+            columns[(i, j)] = dq[i];
+            columns[(N + i, j)] = dv[i];
+        }
+    }
+    let svd = nalgebra::linalg::SVD::try_new(columns, true, false, 5.0 * f64::EPSILON, 100_000)
+        .ok_or(PeriodicError::Decomposition)?;
+    let u = svd.u.as_ref().ok_or(PeriodicError::Decomposition)?;
+    let largest = svd.singular_values.max();
+    let kept: Vec<usize> = (0..svd.singular_values.len())
+        .filter(|&k| svd.singular_values[k] > 1e-8 * largest)
+        .collect();
+    let range = DMatrix::from_fn(2 * N, kept.len(), |i, k| u[(i, kept[k])]);
+    // Within the range, the complement of w = rangeᵀ(df, 0), by a
+    // Householder reflection that takes w to |w| e₁.
+    let df = model.normal(wall, &x.q);
+    let mut g = DVector::zeros(2 * N);
+    for i in 0..N {
+        g[i] = df[i];
+    }
+    let w = range.transpose() * g;
+    let size = w.norm();
+    // NaN fails the comparison too.
+    if size.partial_cmp(&(1e-12 * norm(&df))) != Some(core::cmp::Ordering::Greater)
+        || kept.len() < 2
+    {
+        return Err(PeriodicError::NoSection);
+    }
+    let mut h = w.clone();
+    h[0] -= if w[0] >= 0.0 { -size } else { size };
+    let h = h.normalize();
+    let reflection = DMatrix::identity(kept.len(), kept.len()) - 2.0 * &h * h.transpose();
+    let complement = reflection.columns(1, kept.len() - 1).into_owned();
+    Ok(range * complement)
+}
+
+/// x + λ Z ξ put back on the constraints and the wall's section.
+fn restore<M: Surfaces<N>, const N: usize>(
+    model: &M,
+    x: &State<N>,
+    dx: &DVector<f64>,
+    lambda: f64,
+    wall: M::Wall,
+) -> Result<State<N>, PeriodicError<M::Wall>> {
+    let moved = State {
+        t: 0.0,
+        q: core::array::from_fn(|i| x.q[i] + lambda * dx[i]),
+        v: core::array::from_fn(|i| x.v[i] + lambda * dx[N + i]),
+    };
+    project(model, &moved, wall).map_err(PeriodicError::Projection)
+}
+
+/// `x` put on the constraints and on `wall`'s section: q onto h(q) = 0
+/// and f(q) = 0 together (Gauss–Newton, the smallest change in the metric
+/// of G), then q̇ onto ker A(q). Along a perturbation tangent to both it
+/// changes the state at the second order only.
+pub fn project<M: Surfaces<N>, const N: usize>(
+    model: &M,
+    x: &State<N>,
+    wall: M::Wall,
+) -> Result<State<N>, ProjectorError> {
+    let mut q = x.q;
+    for _ in 0..20 {
+        let holonomic = model.holonomic(&q);
+        let mut r: Vec<f64> = holonomic.as_slice().to_vec();
+        r.push(model.surface(wall, &q));
+        if r.iter()
+            .all(|e| e.abs() <= 4.0 * f64::EPSILON * (1.0 + norm(&q)))
+        {
+            break;
+        }
+        let a = model.constraints(&q);
+        let mut rows: Vec<[f64; N]> = a.as_slice()[..holonomic.as_slice().len()].to_vec();
+        rows.push(model.normal(wall, &q));
+        let d = linalg::correction(&model.mass_matrix(&q), &rows, &r)?;
+        q = core::array::from_fn(|i| q[i] - d[i]);
+    }
+    let v = admissible(model, &q, &x.v)?;
+    Ok(State { t: x.t, q, v })
+}
+
+/// Eigenvalues of Zᵀ DΠ Z, largest modulus first (then by argument).
+fn multipliers<W, const N: usize>(
+    z: &DMatrix<f64>,
+    jacobian: &StateMatrix<N>,
+) -> Result<Vec<[f64; 2]>, PeriodicError<W>> {
+    let m = z.transpose() * dense(jacobian) * z;
+    // Near-defective matrices (the Jordan blocks of families) can keep
+    // the QR iteration from deflating at the tightest tolerance; the
+    // eigenvalues are no more accurate than the square root of DΠ's error
+    // there anyway.
+    let schur = [1e-14, 1e-12, 1e-10]
+        .into_iter()
+        .find_map(|eps| m.clone().try_schur(eps, 100_000))
+        .ok_or(PeriodicError::Decomposition)?;
+    let mut out: Vec<[f64; 2]> = schur
+        .complex_eigenvalues()
+        .iter()
+        .map(|c| [c.re, c.im])
+        .collect();
+    // Moduli equal to 1e-9 (rounding apart) sort by argument.
+    out.sort_by(|a, b| {
+        let key = |m: &[f64; 2]| {
+            (
+                libm::round(1e9 * libm::hypot(m[0], m[1])),
+                libm::atan2(m[1], m[0]),
+            )
+        };
+        let (ka, kb) = (key(a), key(b));
+        kb.0.total_cmp(&ka.0).then(ka.1.total_cmp(&kb.1))
+    });
+    Ok(out)
+}
+
+fn norm<const N: usize>(x: &[f64; N]) -> f64 {
+    libm::sqrt(linalg::dot(x, x))
+}
+
+fn norm_inf<const N: usize>(x: &[f64; N]) -> f64 {
+    x.iter().fold(0.0, |m, e| m.max(e.abs()))
+}

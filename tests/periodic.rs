@@ -1,0 +1,278 @@
+//! Return maps and periodic orbits through collisions
+//! (`simulate::return_map`, `periodic`), against independent answers:
+//! DΠ against Richardson differences of whole return maps along the
+//! section; §3.2.1's orbit and its multipliers as the linear theory of
+//! Theorem 3.2's map predicts; Garwin's superball's vertical bounce and its
+//! multipliers in closed form.
+
+mod common;
+
+use dalembert::models::{BallBounce, Chain3, PendulumWall, Superball};
+use dalembert::runtime::periodic::{self, PeriodicError, Search, Stability};
+use dalembert::runtime::prelude::*;
+use dalembert::runtime::simulate::{
+    Integrator, ReturnError, Section, Settings, State, Taylor, return_map,
+};
+
+use common::{admissible_direction, dormand_prince, initial, richardson};
+
+/// A direction along the section at x (on the wall, leaving it): an
+/// admissible one with its component along the flow F = (v, q̈) taken
+/// off so that df·δq = 0 (F is admissible and crosses the section).
+fn along_section<M: Surfaces<N>, const N: usize>(
+    m: &M,
+    wall: M::Wall,
+    x: &State<N>,
+    seed: &mut u64,
+) -> Vec<f64> {
+    let (dq, dv) = admissible_direction(m, &x.q, &x.v, seed).unwrap();
+    let df = m.normal(wall, &x.q);
+    let a = dalembert::runtime::dynamics::qdd(m, &x.q, &x.v).unwrap();
+    let dot = |a: &[f64; N], b: &[f64; N]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+    let s = dot(&df, &dq) / dot(&df, &x.v);
+    let mut out = vec![0.0; 2 * N];
+    for i in 0..N {
+        out[i] = dq[i] - s * x.v[i];
+        out[N + i] = dv[i] - s * a[i];
+    }
+    out
+}
+
+fn flat<const N: usize>(x: &State<N>) -> Vec<f64> {
+    x.q.iter().chain(&x.v).copied().collect()
+}
+
+/// DΠ δ against Richardson differences of Π(project(x₀ + εδ)) for random
+/// δ along the section: relative error ≤ 1e-6 of |DΠ δ| + |δ|.
+fn jacobian_matches<M: Surfaces<N>, const N: usize>(m: &M, start: State<N>, returns: usize) {
+    let wall = m.walls()[0];
+    let settings = dormand_prince(1e-12);
+    let section = Section {
+        wall,
+        returns,
+        t_max: 100.0,
+    };
+    let x0 = periodic::onto_section(m, start, &section, settings).unwrap();
+    let x0 = State { t: 0.0, ..x0 };
+    let map = return_map(m, x0, &section, settings, Some(1e-12)).unwrap();
+    let jacobian = map.jacobian.unwrap();
+    let mut seed = 7;
+    for _ in 0..3 {
+        let d = along_section(m, wall, &x0, &mut seed);
+        let (dq, dv): ([f64; N], [f64; N]) = (
+            std::array::from_fn(|i| d[i]),
+            std::array::from_fn(|i| d[N + i]),
+        );
+        let (pq, pv) = jacobian.apply(&dq, &dv);
+        let predicted: Vec<f64> = pq.iter().chain(&pv).copied().collect();
+        let differences = richardson(
+            |e| {
+                let moved = State {
+                    t: 0.0,
+                    q: std::array::from_fn(|i| x0.q[i] + e * dq[i]),
+                    v: std::array::from_fn(|i| x0.v[i] + e * dv[i]),
+                };
+                let x = periodic::project(m, &moved, wall).unwrap();
+                flat(&return_map(m, x, &section, settings, None).unwrap().state)
+            },
+            1e-5,
+        );
+        let size = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let error: Vec<f64> = predicted
+            .iter()
+            .zip(&differences)
+            .map(|(a, b)| a - b)
+            .collect();
+        let scale = size(&predicted) + size(&d[..2 * N]);
+        assert!(
+            size(&error) <= 1e-6 * scale,
+            "{}: |DΠ δ − differences| = {:e} against {scale:e}\n{predicted:?}\n{differences:?}",
+            m.name(),
+            size(&error)
+        );
+    }
+}
+
+#[test]
+fn return_map_jacobian_against_differences() {
+    // Two returns of the spinning ball on the rough floor; the superball
+    // meeting the table between its returns to the floor; a chain of three
+    // rods whose tip meets the floor (a curved section in its angles); the
+    // pendulum at a wall (a holonomic constraint).
+    jacobian_matches(&BallBounce::default(), initial(&BallBounce::default()), 2);
+    jacobian_matches(&Superball::default(), initial(&Superball::default()), 1);
+    jacobian_matches(&Chain3::default(), initial(&Chain3::default()), 1);
+    jacobian_matches(
+        &PendulumWall::default(),
+        initial(&PendulumWall::default()),
+        1,
+    );
+}
+
+/// The ball's angular velocity about the fixed x and y axes from its
+/// z-x-z Euler angles and their rates (models/ball_bounce.toml).
+fn omega_xy(q: &[f64; 6], v: &[f64; 6]) -> (f64, f64) {
+    let (phi, theta) = (q[3], q[4]);
+    let (theta_dot, psi_dot) = (v[4], v[5]);
+    (
+        theta_dot * phi.cos() + psi_dot * phi.sin() * theta.sin(),
+        theta_dot * phi.sin() - psi_dot * phi.cos() * theta.sin(),
+    )
+}
+
+/// §3.2.1: the ball thrown to the rough floor returns along its parabola,
+/// so the motion is periodic with two bounces. From the paper's data
+/// perturbed by 1e-3 in single components, Newton's method reaches an
+/// orbit in at most 8 steps with residual ≤ 1e-12, with Dormand–Prince and
+/// with Taylor's method.
+///
+/// What the orbit must be, independently of the search: over two flights
+/// the centre comes back only if its horizontal displacement
+/// (2ż/g)(v₁ + v₁') vanishes, v₁' = a v₁ + b ω₂ the velocity after the
+/// next bounce (Theorem 3.2), which holds exactly when m r v₁ + J ω₂ = 0;
+/// likewise m r v₂ − J ω₁ = 0. The period is two flights, 4ż/g.
+///
+/// The multipliers: the velocity after a bounce is L F v, F = diag(1, 1,
+/// −1, 1, 1, 1) the flight's reversal of v₃ and L = I − 2P Theorem 3.2's
+/// map, both reflections in the metric of G. L F fixes v₃ and ω₃ and acts
+/// on (v₁, ω₂) and (v₂, ω₁) as 2×2 blocks of trace 0 and determinant −1,
+/// whose squares are I (Cayley–Hamilton); so two returns map every
+/// velocity to itself, DΠ's velocity block is I. The position and
+/// attitude do not act on the velocities, and on themselves as I (a
+/// translation moves the orbit, and the rotation of the first flight is
+/// undone by the second). So DΠ on the section is block triangular with I
+/// on the diagonal: all 11 multipliers are 1 (Jordan blocks of size 2:
+/// computed to about the square root of DΠ's error).
+#[test]
+fn section_3_2_1_orbit_and_its_multipliers() {
+    let m = BallBounce::default();
+    let p = *m.params();
+    let section = Section {
+        wall: BallBounce::WALLS[0],
+        returns: 2,
+        t_max: 100.0,
+    };
+    let taylor = Settings {
+        integrator: Integrator::Taylor(Taylor::default()),
+        ..Settings::default()
+    };
+    for (name, settings) in [
+        ("Dormand–Prince", dormand_prince(1e-12)),
+        ("Taylor", taylor),
+    ] {
+        // x_dot, y_dot, z_dot, phi_dot, psi_dot.
+        for k in [6, 7, 8, 9, 11] {
+            let mut start = initial(&m);
+            start.v[k - 6] += 1e-3;
+            let search = Search {
+                settings,
+                tolerance: 1e-12,
+                ..Search::default()
+            };
+            let orbit = periodic::find(&m, start, &section, &search)
+                .unwrap_or_else(|e| panic!("{name}, component {k}: {e:?}"));
+            let at = format!("{name}, component {k}: {orbit:?}");
+            assert!(orbit.iterations <= 8, "{at}");
+            assert!(orbit.residual <= 1e-12, "{at}");
+            let (q, v) = (orbit.state.q, orbit.state.v);
+            let (wx, wy) = omega_xy(&q, &v);
+            assert!((p.m * p.r * v[0] + p.J * wy).abs() <= 1e-9, "{at}");
+            assert!((p.m * p.r * v[1] - p.J * wx).abs() <= 1e-9, "{at}");
+            assert!((orbit.period - 4.0 * v[2] / p.g).abs() <= 1e-12, "{at}");
+            assert_eq!(orbit.multipliers.len(), 11, "{at}");
+            for z in &orbit.multipliers {
+                assert!((z[0] - 1.0).hypot(z[1]) <= 1e-5, "{at}");
+            }
+            assert_eq!(
+                periodic::stability(&orbit.multipliers, search.unit),
+                Stability::Neutral
+            );
+        }
+    }
+}
+
+/// Garwin's superball between the floor and the table: a vertical bounce
+/// is periodic with one return to the floor (two collisions). In the
+/// metric of G the rough impacts reflect (ẋ, ȧ) across the lines normal
+/// to their contact rows, (1/√m, ∓r/√J) after scaling by G^½, at an angle
+/// β with cos β = (J − m r²)/(J + m r²) = −3/7 for J = 2/5 m r²; a floor
+/// and table pair turns (ẋ, ȧ) by 2β, so the multipliers are e^{±2iβ} =
+/// −31/49 ± i√1440/49, and 1 three times (x, the attitude a, and ż, which
+/// both walls reverse exactly). Newton's method must reach the vertical
+/// bounce (ẋ = ȧ = 0, the rotation's only fixed point) from the model's
+/// spinning start; the period is 2(u − w)/g, u the speed leaving the floor
+/// and w = √(u² − 2g(h − 2r)) the speed at the table.
+#[test]
+fn superball_vertical_bounce_and_its_multipliers() {
+    let m = Superball::default();
+    let p = *m.params();
+    let section = Section {
+        wall: Superball::WALLS[0],
+        returns: 1,
+        t_max: 100.0,
+    };
+    let search = Search {
+        settings: dormand_prince(1e-12),
+        tolerance: 1e-12,
+        ..Search::default()
+    };
+    let orbit = periodic::find(&m, initial(&m), &section, &search).unwrap();
+    let at = format!("{orbit:?}");
+    let (x_dot, z_dot, a_dot) = (orbit.state.v[0], orbit.state.v[1], orbit.state.v[2]);
+    assert!(x_dot.abs() <= 1e-12 && a_dot.abs() <= 1e-12, "{at}");
+    let w = (z_dot * z_dot - 2.0 * p.g * (p.h - 2.0 * p.r)).sqrt();
+    assert!(
+        (orbit.period - 2.0 * (z_dot - w) / p.g).abs() <= 1e-12,
+        "{at}"
+    );
+    assert_eq!(orbit.collisions, 2, "{at}");
+    let (re, im) = (-31.0 / 49.0, 1440f64.sqrt() / 49.0);
+    let mut expected = [[1.0, 0.0], [1.0, 0.0], [1.0, 0.0], [re, -im], [re, im]];
+    let mut found = orbit.multipliers.clone();
+    let order = |a: &[f64; 2], b: &[f64; 2]| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1]));
+    expected.sort_by(order);
+    found.sort_by(order);
+    for (f, e) in found.iter().zip(&expected) {
+        assert!(
+            (f[0] - e[0]).hypot(f[1] - e[1]) <= 1e-9,
+            "{found:?} against {expected:?}"
+        );
+    }
+    assert_eq!(found.len(), 5);
+}
+
+/// What the search cannot do is an error that says so: no return within
+/// the time allowed, and a Newton's method given no steps.
+#[test]
+fn failures_are_reported() {
+    let m = PendulumWall::default();
+    let short = Section {
+        wall: PendulumWall::WALLS[0],
+        returns: 1,
+        t_max: 0.05,
+    };
+    let e = periodic::find(&m, initial(&m), &short, &Search::default()).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            PeriodicError::Return(ReturnError::NoReturn { met: 0, .. })
+        ),
+        "{e:?}"
+    );
+    // The chain falls from rest far from an orbit: no Newton steps, no orbit.
+    let chain = Chain3::default();
+    let section = Section {
+        wall: Chain3::WALLS[0],
+        returns: 1,
+        t_max: 100.0,
+    };
+    let search = Search {
+        max_iterations: 0,
+        ..Search::default()
+    };
+    let e = periodic::find(&chain, initial(&chain), &section, &search).unwrap_err();
+    assert!(
+        matches!(e, PeriodicError::NoConvergence { iterations: 0, residual } if residual > 1e-3),
+        "{e:?}"
+    );
+}
