@@ -6,6 +6,7 @@
 //! `check` compares a derivation with a reference file; `simulate` runs a
 //! built-in model through collisions and writes its trajectory and a plot.
 
+mod periodic;
 mod plot;
 mod sim;
 
@@ -75,6 +76,10 @@ enum Command {
     /// Simulate a built-in model through its collisions; write the
     /// trajectory (CSV) and a plot (SVG).
     Simulate(sim::SimulateArgs),
+    /// Find a periodic orbit that returns to a wall after K collisions with
+    /// it (Newton's method on the return map), its period and Floquet
+    /// multipliers, and say whether it is stable.
+    Periodic(periodic::PeriodicArgs),
 }
 
 fn main() -> ExitCode {
@@ -86,6 +91,7 @@ fn main() -> ExitCode {
         Command::Generate { file, output, f32 } => generate(&file, output.as_deref(), f32),
         Command::Check { file, reference } => check(&file, &reference),
         Command::Simulate(args) => sim::simulate(&args),
+        Command::Periodic(args) => periodic::periodic(&args),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,

@@ -38,15 +38,13 @@ pub enum Method {
     Taylor,
 }
 
+/// A model and how to run it: what `simulate` and `periodic` share.
 #[derive(Args, Debug)]
-pub struct SimulateArgs {
+pub struct RunArgs {
     /// A model file (`path/to/model.toml`) or a built-in model with
     /// coordinates (listed below).
     #[arg(long_help = models_help())]
     pub model: String,
-    /// Simulate from t = 0 to this time.
-    #[arg(long, allow_hyphen_values = true, default_value_t = 5.0)]
-    pub t_end: f64,
     /// Integration method.
     #[arg(long, value_enum, default_value_t = Method::DormandPrince)]
     pub integrator: Method,
@@ -74,6 +72,15 @@ pub struct SimulateArgs {
     /// the rest come from the model file (`[parameters]`, `[initial]`).
     #[arg(long = "set", value_name = "NAME=VALUE", value_parser = assignment)]
     pub set: Vec<(String, f64)>,
+}
+
+#[derive(Args, Debug)]
+pub struct SimulateArgs {
+    #[command(flatten)]
+    pub run: RunArgs,
+    /// Simulate from t = 0 to this time.
+    #[arg(long, allow_hyphen_values = true, default_value_t = 5.0)]
+    pub t_end: f64,
     /// Time between output rows (default: t_end / 2000). Collisions are
     /// always written, before and after. With Taylor's method the rows come
     /// off the steps' polynomials; the other methods stop a step at each row.
@@ -126,36 +133,67 @@ fn assignment(s: &str) -> Result<(String, f64), String> {
     Ok((name.trim().to_string(), value))
 }
 
-/// Runs `dalembert simulate`.
-pub fn simulate(args: &SimulateArgs) -> Result<bool, String> {
-    if is_model_file(&args.model) {
-        return simulate_file(args);
+/// What a command does with the model it names, once its size is known.
+pub trait WithModel {
+    /// The command's result.
+    type Output;
+    /// Runs on `model`, whose derived parameters are `derived`.
+    fn with<M: Surfaces<N>, const N: usize>(
+        self,
+        model: M,
+        derived: &[String],
+    ) -> Result<Self::Output, String>;
+}
+
+/// Hands the model `name` names to `command`: a built-in model with
+/// coordinates (compiled), or a model file (derived now, its programs
+/// interpreted, [`dalembert_codegen::interpret`]). `what` says what an
+/// instantaneous model has none of, for the error.
+pub fn with_model<C: WithModel>(name: &str, what: &str, command: C) -> Result<C::Output, String> {
+    if is_model_file(name) {
+        return with_model_file(name, what, command);
     }
     let mut known = Vec::new();
     macro_rules! dispatch {
         ($module:ident, $ty:ident, 0, $n:literal) => {
-            if args.model == stringify!($module) {
+            if name == stringify!($module) {
                 return Err(format!(
-                    "`{}` is an instantaneous model (velocities at the collision instant only): \
-                     it has no motion to simulate; its counterparts in coordinates are \
-                     ball_wall_euler (§3.1) and ball_bounce (§3.2)",
-                    args.model
+                    "`{name}` is an instantaneous model (velocities at the collision instant only): \
+                     it has no {what}; its counterparts in coordinates are \
+                     ball_wall_euler (§3.1) and ball_bounce (§3.2)"
                 ));
             }
         };
         ($module:ident, $ty:ident, $q:literal, $n:literal) => {
-            if args.model == stringify!($module) {
-                return run::<$ty, $q>(args, <$ty>::with_params(Default::default()), &[]);
+            if name == stringify!($module) {
+                return command.with::<$ty, $q>(<$ty>::with_params(Default::default()), &[]);
             }
             known.push(stringify!($module));
         };
     }
     for_each_model!(dispatch);
     Err(format!(
-        "no built-in model `{}` (and no model file of that name); models with coordinates: {}",
-        args.model,
+        "no built-in model `{name}` (and no model file of that name); models with coordinates: {}",
         known.join(", ")
     ))
+}
+
+/// Runs `dalembert simulate`.
+pub fn simulate(args: &SimulateArgs) -> Result<bool, String> {
+    // Before a model file's derivation, which takes seconds.
+    checked_spacing(args)?;
+    struct Simulate<'a>(&'a SimulateArgs);
+    impl WithModel for Simulate<'_> {
+        type Output = bool;
+        fn with<M: Surfaces<N>, const N: usize>(
+            self,
+            model: M,
+            derived: &[String],
+        ) -> Result<bool, String> {
+            run(self.0, model, derived)
+        }
+    }
+    with_model(&args.run.model, "motion to simulate", Simulate(args))
 }
 
 /// Whether the MODEL argument names a file rather than a built-in model:
@@ -168,14 +206,13 @@ fn is_model_file(model: &str) -> bool {
 /// simulator is compiled once for each size up to this.
 pub const MAX_INTERPRETED: usize = 16;
 
-/// `simulate path/to/model.toml`: the model derived now and its programs
-/// interpreted by the same simulator as the built-in models.
-fn simulate_file(args: &SimulateArgs) -> Result<bool, String> {
-    let path = Path::new(&args.model);
+/// A model file derived now and its programs interpreted by the same
+/// simulator as the built-in models.
+fn with_model_file<C: WithModel>(name: &str, what: &str, command: C) -> Result<C::Output, String> {
+    let path = Path::new(name);
     if !path.is_file() {
         return Err(format!("no model file {}", path.display()));
     }
-    checked_spacing(args)?;
     let d: Derivation = crate::derive(path)?;
     let n = d.model.velocities.len();
     macro_rules! sizes {
@@ -183,10 +220,10 @@ fn simulate_file(args: &SimulateArgs) -> Result<bool, String> {
             match n {
                 $($n => {
                     let model = Interpreted::<$n>::new(&d).map_err(|e| e.to_string())?;
-                    run::<Interpreted<$n>, $n>(args, model, &d.model.derived)
+                    command.with::<Interpreted<$n>, $n>(model, &d.model.derived)
                 })*
                 _ => Err(format!(
-                    "`{}` has {n} velocities; the CLI interprets models of 1 to {MAX_INTERPRETED}: generate its Rust code (`dalembert generate`) and simulate it from a crate",
+                    "`{}` has {n} velocities; the CLI interprets models of 1 to {MAX_INTERPRETED}: generate its Rust code (`dalembert generate`) and use it from a crate",
                     d.model.name
                 )),
             }
@@ -194,7 +231,7 @@ fn simulate_file(args: &SimulateArgs) -> Result<bool, String> {
     }
     if d.model.coordinates.is_empty() {
         return Err(format!(
-            "`{}` is an instantaneous model (velocities at the collision instant only): it has no motion to simulate",
+            "`{}` is an instantaneous model (velocities at the collision instant only): it has no {what}",
             d.model.name
         ));
     }
@@ -207,15 +244,6 @@ const MAX_STEPS: f64 = 1e9;
 /// The run's settings checked before anything runs: finite, positive and
 /// within bounds that keep time and output reasonable.
 fn checked_spacing(args: &SimulateArgs) -> Result<f64, String> {
-    let positive = |name: &str, x: f64| {
-        if x.is_finite() && x > 0.0 {
-            Ok(())
-        } else {
-            Err(format!(
-                "{name} must be a positive finite number (got {x:?})"
-            ))
-        }
-    };
     positive("--t-end", args.t_end)?;
     let every = args.every.unwrap_or(args.t_end / 2000.0);
     positive("--every", every)?;
@@ -226,6 +254,24 @@ fn checked_spacing(args: &SimulateArgs) -> Result<f64, String> {
             args.t_end / every
         ));
     }
+    checked_run(&args.run, "--t-end", args.t_end)?;
+    Ok(every)
+}
+
+/// `Ok` where `x` is positive and finite, else an error naming `name`.
+pub fn positive(name: &str, x: f64) -> Result<(), String> {
+    if x.is_finite() && x > 0.0 {
+        Ok(())
+    } else {
+        Err(format!(
+            "{name} must be a positive finite number (got {x:?})"
+        ))
+    }
+}
+
+/// The integrator's settings checked, for a run of at most `span` in
+/// time (given as `flag`).
+pub fn checked_run(args: &RunArgs, flag: &str, span: f64) -> Result<(), String> {
     if !matches!(args.integrator, Method::Taylor) {
         for (flag, given) in [
             ("--tolerance", args.tolerance.is_some()),
@@ -239,12 +285,11 @@ fn checked_spacing(args: &SimulateArgs) -> Result<f64, String> {
     match args.integrator {
         Method::Rk4 => {
             positive("--step", args.step)?;
-            if args.t_end / args.step >= MAX_STEPS {
+            if span / args.step >= MAX_STEPS {
                 return Err(format!(
-                    "--t-end {:?} with --step {:?} would take {:.1e} steps; the limit is {MAX_STEPS:.0e}",
-                    args.t_end,
+                    "{flag} {span:?} with --step {:?} would take {:.1e} steps; the limit is {MAX_STEPS:.0e}",
                     args.step,
-                    args.t_end / args.step
+                    span / args.step
                 ));
             }
         }
@@ -283,7 +328,7 @@ fn checked_spacing(args: &SimulateArgs) -> Result<f64, String> {
             }
         }
     }
-    Ok(every)
+    Ok(())
 }
 
 /// Simulates `model` (whose derived parameters are `derived`) as `args` say.
@@ -294,7 +339,7 @@ fn run<M: Surfaces<N>, const N: usize>(
 ) -> Result<bool, String> {
     let every = checked_spacing(args)?;
     let path = path_axes(&model, args.path.as_deref())?;
-    let (model, start, start_residual) = start(args, model, derived)?;
+    let (model, start, start_residual) = start(&args.run.set, model, derived)?;
     let e0 = model.energy(&start.q, &start.v);
     if !e0.is_finite() {
         return Err(format!(
@@ -302,7 +347,7 @@ fn run<M: Surfaces<N>, const N: usize>(
         ));
     }
     let named = |e: SimError<M::Wall>| e.map_wall(|w| model.wall_name(w)).to_string();
-    let mut sim = Simulator::new(&model, start, settings(args)).map_err(named)?;
+    let mut sim = Simulator::new(&model, start, settings(&args.run)).map_err(named)?;
     std::fs::create_dir_all(&args.out)
         .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
     let csv = args.out.join(format!("{}.csv", model.name()));
@@ -327,8 +372,8 @@ fn run<M: Surfaces<N>, const N: usize>(
         (args.t_end / every * (1.0 - 1e-12)).ceil() as u64 + 1
     );
     let clock = Instant::now();
-    let dense = matches!(args.integrator, Method::Taylor);
-    let mut phi = args.sensitivity.then(|| Variational::new(args.rtol));
+    let dense = matches!(args.run.integrator, Method::Taylor);
+    let mut phi = args.sensitivity.then(|| Variational::new(args.run.rtol));
     let failure = integrate(
         &mut sim,
         &model,
@@ -359,15 +404,15 @@ fn run<M: Surfaces<N>, const N: usize>(
 /// an initial value such as `z = "r"` follows `--set r=1`), then the
 /// coordinates and velocities `--set` names; q on h(q) = 0, q̇ projected
 /// onto ker A.
-fn start<M: Surfaces<N>, const N: usize>(
-    args: &SimulateArgs,
+pub fn start<M: Surfaces<N>, const N: usize>(
+    set: &[(String, f64)],
     mut model: M,
     derived: &[String],
 ) -> Result<(M, State<N>, Residual), String> {
     let is_state = |m: &M, name: &str| {
         m.coordinate_names().contains(&name) || m.velocity_names().contains(&name)
     };
-    for (name, value) in &args.set {
+    for (name, value) in set {
         if is_state(&model, name) {
             continue;
         }
@@ -388,7 +433,7 @@ fn start<M: Surfaces<N>, const N: usize>(
     }
     let mut q = model.initial_coordinates();
     let mut v = model.initial_velocities();
-    for (name, value) in &args.set {
+    for (name, value) in set {
         if let Some(i) = model.coordinate_names().iter().position(|c| c == name) {
             q[i] = *value;
         } else if let Some(i) = model.velocity_names().iter().position(|c| c == name) {
@@ -421,7 +466,7 @@ fn start<M: Surfaces<N>, const N: usize>(
 }
 
 /// The simulator's settings from the command line.
-fn settings(args: &SimulateArgs) -> Settings {
+pub fn settings(args: &RunArgs) -> Settings {
     let integrator = match args.integrator {
         Method::Rk4 => Integrator::Rk4(Rk4 { step: args.step }),
         Method::DormandPrince => Integrator::DormandPrince(DormandPrince {
@@ -548,7 +593,7 @@ fn summary<M: Surfaces<N>, const N: usize>(
         "{}: t = 0 → {} with {:?}{order}",
         model.name(),
         sim.state().t,
-        args.integrator
+        args.run.integrator
     );
     println!(
         "  {} steps ({} rejected), {} collisions, {} evaluations of the equations of motion, in {:.3} s ({:.0} steps/s, {:.0} collisions/s, output included)",

@@ -1,0 +1,167 @@
+//! `dalembert periodic`: every built-in model with walls gets an orbit or
+//! a reason (exit 1, never a crash or a usage error), §3.2.1's two-bounce
+//! orbit through the JSON output, Garwin's superball as a model file
+//! (derived and interpreted now) with its multipliers in closed form
+//! (tests/periodic.rs derives them), and mistakes in the arguments.
+
+use std::process::Command;
+
+fn run(args: &[&str]) -> (Option<i32>, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_dalembert"))
+        .args(args)
+        .output()
+        .expect("the CLI runs");
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// A number after `"key": ` in one-line JSON.
+fn field(json: &str, key: &str) -> f64 {
+    let start = json
+        .find(&format!("\"{key}\": "))
+        .unwrap_or_else(|| panic!("no {key} in {json}"))
+        + key.len()
+        + 4;
+    let rest = &json[start..];
+    let end = rest.find([',', '}']).unwrap();
+    rest[..end].trim().parse().unwrap()
+}
+
+/// The multipliers of the JSON output.
+fn multipliers(json: &str) -> Vec<[f64; 2]> {
+    let start = json.find("\"multipliers\": [").unwrap() + "\"multipliers\": [".len();
+    let end = start + json[start..].find("]]").unwrap() + 1;
+    json[start..end]
+        .split("], [")
+        .map(|pair| {
+            let pair = pair.trim_matches(['[', ']']);
+            let (re, im) = pair.split_once(", ").unwrap();
+            [re.parse().unwrap(), im.parse().unwrap()]
+        })
+        .collect()
+}
+
+#[test]
+fn every_built_in_model_with_walls_gets_an_orbit_or_a_reason() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../models");
+    let mut models: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| {
+            let path = e.unwrap().path();
+            let text = std::fs::read_to_string(&path).ok()?;
+            let moving = text.contains("[coordinates]") && text.contains("[[wall]]");
+            (path.extension()? == "toml" && moving)
+                .then(|| path.file_stem().unwrap().to_string_lossy().into_owned())
+        })
+        .collect();
+    models.sort();
+    assert!(models.len() >= 10, "{models:?}");
+    let mut found = 0;
+    for model in &models {
+        let (code, stdout, stderr) = run(&["periodic", model]);
+        match code {
+            Some(0) => {
+                assert!(
+                    stdout.contains("periodic orbit through"),
+                    "{model}: {stdout}"
+                );
+                assert!(stdout.contains("stability: "), "{model}: {stdout}");
+                found += 1;
+            }
+            Some(1) => assert!(
+                stderr.starts_with(&format!("no periodic orbit of {model} through `")),
+                "{model}: {stderr}"
+            ),
+            other => panic!("{model}: exit {other:?}\n{stdout}\n{stderr}"),
+        }
+    }
+    // The balls on the floor, the pendulum, the superball at least.
+    assert!(found >= 5, "orbits found for {found} of {models:?}");
+}
+
+#[test]
+fn section_3_2_1_through_the_json_output() {
+    let (code, stdout, stderr) = run(&[
+        "periodic",
+        "ball_bounce",
+        "--collisions",
+        "2",
+        "--set",
+        "x_dot=1.001",
+        "--residual",
+        "1e-12",
+        "--json",
+    ]);
+    assert_eq!(code, Some(0), "{stderr}");
+    let json = stdout.trim();
+    assert!(field(json, "residual") <= 1e-12, "{json}");
+    assert!(field(json, "iterations") <= 8.0, "{json}");
+    // Two flights of 2ż/g each.
+    assert!(
+        (field(json, "period") - 4.0 * field(json, "z_dot") / 9.81).abs() <= 1e-12,
+        "{json}"
+    );
+    let found = multipliers(json);
+    assert_eq!(found.len(), 11, "{json}");
+    assert!(
+        found.iter().all(|z| (z[0] - 1.0).hypot(z[1]) <= 1e-5),
+        "{json}"
+    );
+    assert!(json.contains("\"stability\": \"neutral\""), "{json}");
+}
+
+#[test]
+fn the_superball_as_a_model_file() {
+    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../models/superball.toml");
+    let (code, stdout, stderr) = run(&["periodic", file, "--rtol", "1e-12", "--json"]);
+    assert_eq!(code, Some(0), "{stderr}");
+    let json = stdout.trim();
+    assert!(
+        field(json, "x_dot").abs() <= 1e-12 && field(json, "a_dot").abs() <= 1e-12,
+        "{json}"
+    );
+    let (re, im) = (-31.0 / 49.0, 1440f64.sqrt() / 49.0);
+    let found = multipliers(json);
+    for target in [[re, im], [re, -im]] {
+        assert!(
+            found
+                .iter()
+                .any(|z| (z[0] - target[0]).hypot(z[1] - target[1]) <= 1e-9),
+            "{target:?} in {json}"
+        );
+    }
+    assert_eq!(
+        found
+            .iter()
+            .filter(|z| (z[0] - 1.0).hypot(z[1]) <= 1e-9)
+            .count(),
+        3,
+        "{json}"
+    );
+}
+
+#[test]
+fn mistakes_in_the_arguments() {
+    for (args, says) in [
+        (
+            &["periodic", "superball", "--wall", "ceiling"][..],
+            "`ceiling` is not a wall of superball (floor, table)",
+        ),
+        (
+            &["periodic", "superball", "--collisions", "0"][..],
+            "--collisions must be at least 1",
+        ),
+        (
+            &["periodic", "superball", "--t-max", "-1"][..],
+            "--t-max must be a positive finite number",
+        ),
+        (&["periodic", "ball_floor"][..], "instantaneous model"),
+    ] {
+        let (code, _, stderr) = run(args);
+        assert_eq!(code, Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(says), "{args:?}: {stderr}");
+    }
+}
