@@ -7,7 +7,9 @@
 //! quotients (interpreted), a nonholonomic sleigh in a round rink
 //! (interpreted), a holonomic pendulum at a wall and a spinning ball on a
 //! rough floor (generated). And an exact identity: energy is kept by flight
-//! and map, so ∇E(x(T))ᵀ Φ(T) δx₀ = ∇E(x₀)ᵀ δx₀.
+//! and map, so ∇E(x(T))ᵀ Φ(T) δx₀ = ∇E(x₀)ᵀ δx₀; and A(q)q̇ = 0, h(q) = 0
+//! hold along every run, so Φ(T) δx₀ is tangent to them (the sleigh's
+//! nonholonomic rows, the pendulum's holonomic one).
 //!
 //! Uses the symbolic engine for the interpreted models: run one test at a
 //! time (`RUST_TEST_THREADS=1`).
@@ -212,6 +214,34 @@ fn check<M: Surfaces<N>, const N: usize>(m: &M, x0: ([f64; N], [f64; N]), t_end:
                 "{} ({method}), direction {k}: ∇E·Φδx₀ {after} against ∇E·δx₀ {before}",
                 m.name()
             );
+            // A(q)q̇ = 0 (and h(q) = 0) hold along every run, so Φ δx₀
+            // stays tangent to them: A δv + (∂A/∂q δq) v = 0 and
+            // ∂h/∂q δq = 0 at T, ∂A/∂q δq by central differences of A.
+            let a = m.constraints(&end.q);
+            let along = |s: f64| {
+                let q: [f64; N] = std::array::from_fn(|i| end.q[i] + s * pq[i]);
+                m.constraints(&q).apply(&end.v)
+            };
+            let h = 1e-6;
+            let (plus, minus, av) = (along(h), along(-h), a.apply(&pv));
+            let holonomic = m.holonomic(&end.q).as_slice().len();
+            for r in 0..a.len() {
+                let rate =
+                    av.as_slice()[r] + (plus.as_slice()[r] - minus.as_slice()[r]) / (2.0 * h);
+                assert!(
+                    rate.abs() <= 1e-6 * scale,
+                    "{} ({method}), direction {k}: row {r} of d(A q̇)·Φδx₀ = {rate:e}",
+                    m.name()
+                );
+                if r < holonomic {
+                    let dh: f64 = (0..N).map(|i| a.as_slice()[r][i] * pq[i]).sum();
+                    assert!(
+                        dh.abs() <= 1e-6 * scale,
+                        "{} ({method}): dh·Φδq = {dh:e}",
+                        m.name()
+                    );
+                }
+            }
         }
     }
 }
