@@ -8,7 +8,10 @@
 //!   (`accelerations_jacobian`, `collide_jacobian`).
 //!
 //! And §3.2.1's bounce through 100 bounces with and without Φ followed
-//! (`simulate::Variational`, rtol 1e-10).
+//! (`simulate::Variational`, rtol 1e-10); its two-bounce return map with
+//! and without DΠ (`simulate::return_map`, rtol 1e-12), and the search of
+//! its orbit from the paper's start with ẋ off by 1e-3 (`periodic::find`,
+//! one Newton step at its default tolerance).
 //!
 //! The tangent's value is checked equal to the function's first. Time is
 //! the thread's CPU time. Run: `cargo bench --bench tangents`.
@@ -92,6 +95,44 @@ fn variational(c: &mut Criterion<ThreadCpuTime>) {
     g.finish();
 }
 
+/// §3.2.1's return map over two bounces, alone and with DΠ, and the
+/// orbit's search.
+fn periodic(c: &mut Criterion<ThreadCpuTime>) {
+    use dalembert::models::BallBounce;
+    use dalembert::runtime::periodic::{Search, find};
+    use dalembert::runtime::simulate::{Section, State, return_map};
+    let m = BallBounce::default();
+    let start = State {
+        t: 0.0,
+        q: m.initial_coordinates(),
+        v: m.initial_velocities(),
+    };
+    let section = Section {
+        wall: BallBounce::WALLS[0],
+        returns: 2,
+        t_max: 100.0,
+    };
+    let search = Search::default();
+    let map = |jacobian| return_map(&m, start, &section, search.settings, jacobian).unwrap();
+    assert_eq!(map(None).state, map(Some(1e-12)).state, "DΠ leaves Π alone");
+    let mut off = start;
+    off.v[0] += 1e-3;
+    let orbit = find(&m, off, &section, &search).unwrap();
+    assert_eq!(
+        orbit.iterations, 1,
+        "one Newton step at the default tolerance"
+    );
+    let mut g = c.benchmark_group("periodic/ball_bounce_two_bounces");
+    g.bench_function("return_map", |b| b.iter(|| map(black_box(None))));
+    g.bench_function("return_map_and_jacobian", |b| {
+        b.iter(|| map(black_box(Some(1e-12))))
+    });
+    g.bench_function("find_from_1e-3_off", |b| {
+        b.iter(|| find(&m, black_box(off), &section, &search).unwrap())
+    });
+    g.finish();
+}
+
 fn models(c: &mut Criterion<ThreadCpuTime>) {
     use dalembert::models::*;
     one::<BallWallEuler, 5>(c);
@@ -102,6 +143,6 @@ fn models(c: &mut Criterion<ThreadCpuTime>) {
 criterion_group! {
     name = benches;
     config = Criterion::default().with_measurement(ThreadCpuTime);
-    targets = models, variational
+    targets = models, variational, periodic
 }
 criterion_main!(benches);

@@ -139,9 +139,10 @@ fn failure<M: Surfaces<N>, const N: usize>(
             "the motion grazes `{}` (normal velocity {normal_velocity:e}): the return map has no derivative there",
             model.wall_name(w)
         ),
-        PeriodicError::Return(ReturnError::Variational(e)) => {
-            format!("no derivative of the return map: {e:?}")
-        }
+        PeriodicError::Return(ReturnError::Variational(e)) => format!(
+            "the return map has no derivative: {}",
+            crate::sim::sensitivity::failure(model, e)
+        ),
         PeriodicError::Return(ReturnError::Dynamics(e)) => {
             format!("q̈ at a return could not be computed: {e:?}")
         }

@@ -22,7 +22,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use crate::plot::plot;
 
 mod output;
-mod sensitivity;
+pub(crate) mod sensitivity;
 pub use output::Row;
 use output::{MAX_ROWS, Output};
 

@@ -6,7 +6,7 @@ use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{State, Variational, VariationalError, tangent_direction};
 
 /// Why Φ could not follow the run, naming walls as the model file does.
-pub(super) fn failure<M: Surfaces<N>, const N: usize>(
+pub(crate) fn failure<M: Surfaces<N>, const N: usize>(
     model: &M,
     e: VariationalError<M::Wall>,
 ) -> String {
