@@ -99,8 +99,8 @@ fn variational(c: &mut Criterion<ThreadCpuTime>) {
 /// orbit's search.
 fn periodic(c: &mut Criterion<ThreadCpuTime>) {
     use dalembert::models::BallBounce;
-    use dalembert::runtime::periodic::{Search, find};
     use dalembert::runtime::simulate::{Section, State, return_map};
+    use dalembert_periodic::{Search, find};
     let m = BallBounce::default();
     let start = State {
         t: 0.0,

@@ -8,11 +8,11 @@
 mod common;
 
 use dalembert::models::{BallBounce, Chain3, PendulumWall, Superball};
-use dalembert::runtime::periodic::{self, PeriodicError, Search, Stability};
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
     Integrator, ReturnError, Section, Settings, State, Taylor, return_map,
 };
+use dalembert_periodic::{self as periodic, PeriodicError, Search, Stability};
 
 use common::{admissible_direction, dormand_prince, initial, richardson};
 

@@ -1,12 +1,12 @@
 //! `dalembert periodic`: a periodic orbit through collisions by Newton's
 //! method on a wall's return map, its Floquet multipliers and their
-//! verdict (`dalembert_runtime::periodic`).
+//! verdict (crate `dalembert-periodic`).
 
 use clap::Args;
-use dalembert::runtime::periodic::{self, Orbit, PeriodicError, Search, Stability};
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::saltation::SaltationError;
 use dalembert::runtime::simulate::{ReturnError, Section, VariationalError};
+use dalembert_periodic::{self as periodic, Orbit, PeriodicError, Search, Stability};
 
 use crate::sim::{RunArgs, WithModel, checked_run, positive, settings, start, with_model};
 

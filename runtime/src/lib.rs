@@ -20,8 +20,6 @@
 
 pub mod dynamics;
 pub mod linalg;
-#[cfg(feature = "periodic")]
-pub mod periodic;
 pub mod saltation;
 pub mod simulate;
 pub mod taylor;

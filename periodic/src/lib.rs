@@ -1,5 +1,7 @@
-//! Periodic orbits through collisions and their Floquet multipliers
-//! (feature `periodic`: dense linear algebra from nalgebra, on the heap).
+//! Periodic orbits through collisions and their Floquet multipliers, for
+//! any model of `dalembert-runtime` (dense linear algebra from nalgebra, on
+//! the heap; the runtime's return map, `simulate::return_map`, needs
+//! neither).
 //!
 //! An orbit is sought as a fixed point of a wall's return map Π
 //! ([`return_map`]): a state x₀ just after a collision with the wall from
@@ -23,16 +25,15 @@
 //! (the flow's own direction, whose multiplier is always 1, is not in
 //! it). Every family and symmetry adds multipliers equal to 1.
 
-extern crate alloc;
-
-use alloc::vec::Vec;
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::Surfaces;
-use crate::linalg::{self, ProjectorError};
-use crate::saltation::StateMatrix;
-use crate::simulate::{
+use dalembert_runtime::Surfaces;
+use dalembert_runtime::linalg::{self, ProjectorError};
+use dalembert_runtime::saltation::StateMatrix;
+use dalembert_runtime::simulate::{
     Return, ReturnError, Section, Settings, Simulator, State, admissible, return_map,
     tangent_direction,
 };
@@ -245,9 +246,12 @@ pub fn find<M: Surfaces<N>, const N: usize>(
         // residual.
         let mut lambda = 1.0;
         let mut accepted = None;
+        // A trial that cannot be put back on the constraints, or whose
+        // return map fails, is rejected like one that does not lower the
+        // residual.
         for _ in 0..=search.halvings {
-            let trial = restore(model, &x, &dx, lambda, section.wall)?;
-            if let Ok(map) = return_map(model, trial, section, search.settings, None)
+            if let Ok(trial) = restore(model, &x, &dx, lambda, section.wall)
+                && let Ok(map) = return_map(model, trial, section, search.settings, None)
                 && residual_of(&trial, &map) < residual
             {
                 accepted = Some(trial);
@@ -265,7 +269,7 @@ pub fn find<M: Surfaces<N>, const N: usize>(
 /// The linear stability the multipliers give, with `unit` the distance
 /// from the unit circle that counts as on it.
 pub fn stability(multipliers: &[[f64; 2]], unit: f64) -> Stability {
-    let modulus = |m: &[f64; 2]| libm::hypot(m[0], m[1]);
+    let modulus = |m: &[f64; 2]| m[0].hypot(m[1]);
     let largest = multipliers.iter().map(modulus).fold(0.0, f64::max);
     if largest > 1.0 + unit {
         return Stability::Unstable { largest };
@@ -416,12 +420,7 @@ fn multipliers<W, const N: usize>(
         .collect();
     // Moduli equal to 1e-9 (rounding apart) sort by argument.
     out.sort_by(|a, b| {
-        let key = |m: &[f64; 2]| {
-            (
-                libm::round(1e9 * libm::hypot(m[0], m[1])),
-                libm::atan2(m[1], m[0]),
-            )
-        };
+        let key = |m: &[f64; 2]| ((1e9 * m[0].hypot(m[1])).round(), m[1].atan2(m[0]));
         let (ka, kb) = (key(a), key(b));
         kb.0.total_cmp(&ka.0).then(ka.1.total_cmp(&kb.1))
     });
@@ -429,9 +428,34 @@ fn multipliers<W, const N: usize>(
 }
 
 fn norm<const N: usize>(x: &[f64; N]) -> f64 {
-    libm::sqrt(linalg::dot(x, x))
+    linalg::dot(x, x).sqrt()
 }
 
 fn norm_inf<const N: usize>(x: &[f64; N]) -> f64 {
     x.iter().fold(0.0, |m, e| m.max(e.abs()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Stability, stability};
+
+    #[test]
+    fn the_verdict_reads_the_moduli() {
+        let circle = [[0.6, 0.8], [0.6, -0.8], [1.0, 0.0]];
+        assert_eq!(stability(&circle, 1e-5), Stability::Neutral);
+        let outside = [[1.0, 0.0], [1.5, 0.0], [1.0 / 1.5, 0.0]];
+        assert_eq!(
+            stability(&outside, 1e-5),
+            Stability::Unstable { largest: 1.5 }
+        );
+        let inside = [[1.0, 0.0], [0.0, 0.5]];
+        assert_eq!(
+            stability(&inside, 1e-5),
+            Stability::Stable {
+                largest_inside: 0.5
+            }
+        );
+        // Within the tolerance of the circle counts as on it.
+        assert_eq!(stability(&[[1.0 + 1e-7, 0.0]], 1e-5), Stability::Neutral);
+    }
 }
