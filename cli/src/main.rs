@@ -8,6 +8,7 @@
 
 mod periodic;
 mod plot;
+mod run;
 mod sim;
 
 use std::path::{Path, PathBuf};

@@ -8,7 +8,7 @@ use dalembert::runtime::saltation::SaltationError;
 use dalembert::runtime::simulate::{ReturnError, Section, VariationalError};
 use dalembert_periodic::{self as periodic, Orbit, PeriodicError, Search, Stability};
 
-use crate::sim::{RunArgs, WithModel, checked_run, positive, settings, start, with_model};
+use crate::run::{RunArgs, WithModel, checked_run, positive, settings, start, with_model};
 
 #[derive(Args, Debug)]
 pub struct PeriodicArgs {

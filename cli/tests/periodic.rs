@@ -4,19 +4,8 @@
 //! (derived and interpreted now) with its multipliers in closed form
 //! (tests/periodic.rs derives them), and mistakes in the arguments.
 
-use std::process::Command;
-
-fn run(args: &[&str]) -> (Option<i32>, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_dalembert"))
-        .args(args)
-        .output()
-        .expect("the CLI runs");
-    (
-        out.status.code(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+mod common;
+use common::dalembert_exit as run;
 
 /// A number after `"key": ` in one-line JSON.
 fn field(json: &str, key: &str) -> f64 {
