@@ -57,7 +57,19 @@ fn wall(
     let Some(b) = rows(c, cx, w, raw)? else {
         return Ok(None);
     };
-    let (b_mat, b_atoms, kept, dropped) = (b.matrix, b.atoms, b.origin, b.dropped);
+    let (b_mat, b_atoms, kept, dropped, steady) =
+        (b.matrix, b.atoms, b.origin, b.dropped, b.steady);
+    if !steady && c.g_inv.is_none() {
+        return Err(cx.error(
+            ErrorKind::Structure(format!(
+                "wall `{}`: the rows of B kept ({}) become dependent where the removed ones ({}) do not, so P solved from them at run time would be wrong there; derive P exactly (`projector = \"symbolic\"`) or write rows that stay independent on the wall",
+                w.name,
+                kept.join("; "),
+                dropped.join("; ")
+            )),
+            span.clone(),
+        ));
+    }
     let closed = match c.g_inv {
         Some(g_inv) => Some(closed_form(sym, low, g_inv, &b_mat).ok_or_else(|| {
             cx.error(
@@ -127,7 +139,10 @@ fn wall(
         }
         None => Projection::Structured,
     };
-    if let Some(f) = elimination::collision(c.sym, c.exact, c.compile, cx, &b_atoms, &w.span)? {
+    // Elimination evaluates B's kept rows: only where they span the rest.
+    if steady
+        && let Some(f) = elimination::collision(c.sym, c.exact, c.compile, cx, &b_atoms, &w.span)?
+    {
         candidates.push((Form::Elimination, f));
     }
     let collision = elimination::choose(sym.params.len(), candidates);
@@ -158,6 +173,8 @@ struct WallB {
     atoms: Vec<Vec<Atom>>,
     origin: Vec<String>,
     dropped: Vec<String>,
+    /// Whether the kept rows span the dropped ones everywhere ([`steady`]).
+    steady: bool,
 }
 
 /// B's candidate rows (the normal velocity, A's rows, the contact rows)
@@ -183,6 +200,13 @@ fn rows(
     }
     let (kept, dropped) = independent_rows(&candidates, n, &exact.field);
     let b: Vec<Vec<Rat>> = kept.iter().map(|(r, _)| r.clone()).collect();
+    let spans = steady(
+        c,
+        &b,
+        &dropped.iter().map(|(r, _)| r.clone()).collect::<Vec<_>>(),
+        n,
+    );
+    let dropped: Vec<String> = dropped.into_iter().map(|(_, o)| o).collect();
     checks::wall_hypotheses(cx, w, &b, &exact.a, &candidates[0].0, &exact.field);
     if kept.is_empty() {
         return Ok(None);
@@ -212,6 +236,7 @@ fn rows(
         atoms,
         origin: kept.into_iter().map(|(_, o)| o).collect(),
         dropped,
+        steady: spans,
     }))
 }
 
@@ -473,7 +498,7 @@ fn independent_rows(
     candidates: &[(Vec<Rat>, String)],
     n: usize,
     field: &Field,
-) -> (Vec<(Vec<Rat>, String)>, Vec<String>) {
+) -> (Vec<(Vec<Rat>, String)>, Vec<(Vec<Rat>, String)>) {
     let mut kept: Vec<(Vec<Rat>, String)> = Vec::new();
     let mut dropped = Vec::new();
     for (row, origin) in candidates {
@@ -483,8 +508,36 @@ fn independent_rows(
         if rank == trial.len() {
             kept.push((row.clone(), origin.clone()));
         } else {
-            dropped.push(origin.clone());
+            dropped.push((row.clone(), origin.clone()));
         }
     }
     (kept, dropped)
+}
+
+/// Whether the kept rows span every dropped row with coefficients free of
+/// q: λᵀ = d Kᵀ (K Kᵀ)⁻¹ for each dropped row d. Where a coefficient
+/// varies, it has a pole somewhere, and there the kept rows may span less
+/// than all the candidates do (three no-slip rows of a ball in a spherical
+/// wall with the normal velocity: any three of the four degenerate on a
+/// great circle of the wall). P itself is the same rational function for
+/// any basis of the span, so the closed form stays right everywhere; what
+/// evaluates B's kept rows at run time does not.
+fn steady(c: &Context, kept: &[Vec<Rat>], dropped: &[Vec<Rat>], n: usize) -> bool {
+    if dropped.is_empty() {
+        return true;
+    }
+    let field = &c.exact.field;
+    let Some(k) = rows_matrix(kept, n, field) else {
+        return false;
+    };
+    let Ok(inverse) = (&k * &k.transpose()).inv() else {
+        return false;
+    };
+    dropped.iter().all(|d| {
+        let Some(row) = rows_matrix(std::slice::from_ref(d), n, field) else {
+            return false;
+        };
+        let lambda = &(&row * &k.transpose()) * &inverse;
+        (0..kept.len()).all(|i| !varies(c, &c.low.simplify(&lambda[(0, i as u32)])))
+    })
 }

@@ -14,7 +14,14 @@ pub(super) struct File {
     pub(super) velocities: Option<Spanned<Names>>,
     #[serde(default)]
     pub(super) definitions: IndexMap<Spanned<String>, Spanned<String>>,
-    pub(super) dynamics: Spanned<Dynamics>,
+    pub(super) dynamics: Option<Spanned<Dynamics>>,
+    #[serde(default)]
+    pub(super) body: Vec<Spanned<BodyDecl>>,
+    pub(super) fields: Option<Spanned<Fields>>,
+    #[serde(default)]
+    pub(super) rolling: Vec<Spanned<RollingDecl>>,
+    #[serde(default)]
+    pub(super) knife_edge: Vec<Spanned<KnifeEdgeDecl>>,
     #[serde(default)]
     pub(super) wall: Vec<Spanned<WallDecl>>,
     #[serde(default)]
@@ -57,10 +64,10 @@ pub(super) struct Names {
     pub(super) velocities: Option<Vec<Spanned<String>>>,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub(super) struct Dynamics {
-    pub(super) kinetic_energy: Spanned<String>,
+    pub(super) kinetic_energy: Option<Spanned<String>>,
     pub(super) potential: Option<Spanned<String>>,
     #[serde(default)]
     pub(super) holonomic: Vec<Spanned<String>>,
@@ -78,4 +85,94 @@ pub(super) struct WallDecl {
     pub(super) normal_velocity: Option<Spanned<String>>,
     #[serde(default)]
     pub(super) contact: Vec<Spanned<String>>,
+    /// With bodies: the body that meets the wall.
+    pub(super) body: Option<Spanned<String>>,
+    /// With bodies: the wall's shape, one of these three.
+    pub(super) plane: Option<Spanned<PlaneDecl>>,
+    pub(super) sphere: Option<Spanned<RoundDecl>>,
+    pub(super) cylinder: Option<Spanned<RoundDecl>>,
+    /// With bodies: `smooth` (the default) or `rough`.
+    pub(super) law: Option<Spanned<String>>,
+}
+
+/// A rigid body (`[[body]]`): the bodies layer derives T, V and the
+/// constraint and contact rows from these.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct BodyDecl {
+    pub(super) name: Spanned<String>,
+    pub(super) mass: Spanned<Number>,
+    /// A number (a ball), three principal moments, or a 3×3 tensor, in the
+    /// body frame about the centre.
+    pub(super) inertia: Option<Spanned<Inertia>>,
+    /// The centre in the fixed frame, as expressions of the coordinates.
+    pub(super) position: Spanned<Vec<Spanned<Number>>>,
+    pub(super) orientation: Option<Spanned<OrientationDecl>>,
+    /// The contact shape: a sphere of this radius about the centre (absent:
+    /// the centre is a point that meets walls).
+    pub(super) radius: Option<Spanned<Number>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+pub(super) enum Inertia {
+    Tensor(Vec<Vec<Number>>),
+    Principal(Vec<Number>),
+    Ball(Number),
+}
+
+/// One of: `angle` (with `axis`), `euler` with `angles`, `quaternion`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct OrientationDecl {
+    pub(super) angle: Option<Spanned<String>>,
+    pub(super) axis: Option<Spanned<String>>,
+    pub(super) euler: Option<Spanned<String>>,
+    pub(super) angles: Option<Spanned<Vec<Spanned<String>>>>,
+    pub(super) quaternion: Option<Spanned<Vec<Spanned<String>>>>,
+}
+
+/// Fields acting on every body.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct Fields {
+    /// Uniform gravity, a vector (V = −Σ m g · position).
+    pub(super) gravity: Option<Spanned<Vec<Spanned<Number>>>>,
+}
+
+/// The plane n · p = offset, free on the side n points to (n a unit vector).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct PlaneDecl {
+    pub(super) normal: Spanned<Vec<Spanned<Number>>>,
+    #[serde(default)]
+    pub(super) offset: Option<Spanned<Number>>,
+}
+
+/// A sphere (centre, radius) or a cylinder (centre, axis, radius), the body
+/// inside it.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RoundDecl {
+    pub(super) centre: Spanned<Vec<Spanned<Number>>>,
+    pub(super) axis: Option<Spanned<Vec<Spanned<Number>>>>,
+    pub(super) radius: Spanned<Number>,
+}
+
+/// A ball rolling without slipping on a plane.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RollingDecl {
+    pub(super) body: Spanned<String>,
+    pub(super) plane: Spanned<PlaneDecl>,
+}
+
+/// A knife edge (skate) at the body's centre, its blade along a body-frame
+/// direction, on a plane: the centre does not move across the blade.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct KnifeEdgeDecl {
+    pub(super) body: Spanned<String>,
+    pub(super) blade: Spanned<Vec<Spanned<Number>>>,
+    pub(super) normal: Spanned<Vec<Spanned<Number>>>,
 }

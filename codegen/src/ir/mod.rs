@@ -5,6 +5,7 @@
 //! an undeclared name or a malformed expression. This stage does not use the
 //! symbolic engine at all.
 
+mod bodies;
 pub mod expr;
 mod file;
 mod limits;
@@ -313,7 +314,7 @@ pub fn read_source(path: &Path) -> Result<String, ModelErrors> {
 /// Validates the model text `text` (read from `path`).
 pub fn parse(path: &Path, text: &str) -> Result<Model, ModelErrors> {
     let mut cx = Collector::new(path, text);
-    let file: File = match toml::from_str(text) {
+    let mut file: File = match toml::from_str(text) {
         Ok(f) => f,
         Err(e) => {
             let msg = e.message().to_string();
@@ -321,6 +322,7 @@ pub fn parse(path: &Path, text: &str) -> Result<Model, ModelErrors> {
             return Err(cx.into_errors());
         }
     };
+    bodies::expand(&mut file, &mut cx);
     let model = Validator {
         cx: &mut cx,
         text,

@@ -66,9 +66,23 @@ impl Validator<'_> {
         }
         let definitions = self.definitions(all);
 
-        let dyn_span = file.dynamics.span();
-        let dynamics = file.dynamics.into_inner();
-        let kinetic_energy = self.expr(&dynamics.kinetic_energy);
+        let (dyn_span, dynamics) = match file.dynamics {
+            Some(d) => (d.span(), d.into_inner()),
+            None => (header.name.span(), Default::default()),
+        };
+        let kinetic_energy = match &dynamics.kinetic_energy {
+            Some(t) => self.expr(t),
+            None => {
+                self.cx.error(
+                    ErrorKind::Structure(
+                        "the model has no kinetic energy: write `kinetic_energy` in [dynamics], or declare a [[body]]"
+                            .into(),
+                    ),
+                    Some(dyn_span.clone()),
+                );
+                self.expr(&Spanned::new(dyn_span.clone(), "0".to_string()))
+            }
+        };
         let potential = dynamics.potential.as_ref().map(|p| self.expr(p));
         let holonomic = dynamics.holonomic.iter().map(|c| self.expr(c)).collect();
         if kind == Kind::Instantaneous
@@ -452,6 +466,9 @@ impl Validator<'_> {
                 self.cx.error(kind, Some(w.name.span()));
             }
             match (kind, &w.surface, &w.normal_velocity) {
+                // A wall met by a body whose shape could not be read: the
+                // bodies layer has said why.
+                (Kind::Coordinates, None, _) if w.body.is_some() => {}
                 (Kind::Coordinates, None, _) => {
                     self.cx.error(
                         ErrorKind::Structure(format!(

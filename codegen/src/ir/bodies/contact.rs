@@ -1,0 +1,269 @@
+//! What holds where a body touches: a ball rolling on a plane, a knife
+//! edge, and walls by shape (plane, sphere or cylinder from inside) and law
+//! (smooth, or rough: the contact point's no-slip rows).
+
+use std::ops::Range;
+
+use toml::Spanned;
+
+use super::super::file::{KnifeEdgeDecl, PlaneDecl, RollingDecl, RoundDecl, WallDecl};
+use super::frames::{self, Vec3, cross, dot, minus, plus, scale};
+use super::sym::{Sym, div, int, mul, square, sub};
+use super::{Body, Layer, structure};
+
+impl Layer<'_> {
+    /// The body a constraint or wall names.
+    fn find(&mut self, body: &Spanned<String>) -> Option<Body> {
+        if !self.bodies.contains_key(body.get_ref()) {
+            self.cx.error(
+                structure(format!("no [[body]] is named `{}`", body.get_ref())),
+                Some(body.span()),
+            );
+            return None;
+        }
+        self.bodies.get(body.get_ref()).cloned()
+    }
+
+    /// A plane's unit normal, offset and the axis of its largest component.
+    fn plane(&mut self, p: &Spanned<PlaneDecl>) -> Option<(Vec3, Sym, usize)> {
+        let n = self.vector(&p.get_ref().normal)?;
+        let offset = match &p.get_ref().offset {
+            Some(o) => self.sym(o)?,
+            None => int(0),
+        };
+        let at = p.get_ref().normal.span();
+        let k = self.unit_vector(&n, at)?;
+        Some((n, offset, k))
+    }
+
+    /// Checks that `n` is a constant unit vector at the file's values and
+    /// gives the axis of its largest component.
+    fn unit_vector(&mut self, n: &Vec3, at: Range<usize>) -> Option<usize> {
+        let values: Option<Vec<f64>> = n.iter().map(|c| self.value(c)).collect();
+        let Some(values) = values else {
+            self.cx.error(
+                structure("a direction is constant: numbers or expressions of the parameters"),
+                Some(at),
+            );
+            return None;
+        };
+        let length = values.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if (length - 1.0).abs() > 1e-12 {
+            self.cx.error(
+                structure(format!(
+                    "a normal or axis is a unit vector; this one has length {length} at the file's parameter values"
+                )),
+                Some(at),
+            );
+            return None;
+        }
+        let mut k = 0;
+        for i in 1..3 {
+            if values[i].abs() > values[k].abs() {
+                k = i;
+            }
+        }
+        Some(k)
+    }
+
+    /// Rows saying that the point at `offset` from the centre of `body` is
+    /// at rest, except its component along `normal`: the components across
+    /// the normal's largest axis `k` (with the normal's row, they span all
+    /// three); identically zero rows left out.
+    fn no_slip(body: &Body, offset: &Vec3, k: Option<usize>) -> Vec<Sym> {
+        let point = plus(&body.velocity, &cross(&body.omega, offset));
+        (0..3)
+            .filter(|&i| Some(i) != k)
+            .map(|i| point[i].clone())
+            .filter(|r| !r.is_zero())
+            .collect()
+    }
+
+    pub(super) fn rolling(&mut self, decl: &Spanned<RollingDecl>) {
+        let r = decl.get_ref();
+        let Some((n, offset, k)) = self.plane(&r.plane) else {
+            return;
+        };
+        let Some(body) = self.find(&r.body) else {
+            return;
+        };
+        let Some(radius) = body.radius.clone() else {
+            let id = r.body.get_ref().clone();
+            self.cx.error(
+                structure(format!(
+                    "body `{id}` rolls, so it needs `radius`, its contact sphere's"
+                )),
+                Some(r.body.span()),
+            );
+            return;
+        };
+        let rows = Self::no_slip(&body, &scale(&mul([int(-1), radius.clone()]), &n), Some(k));
+        let height = sub(sub(dot(&n, &body.position), offset), radius);
+        let coordinates = &self.coordinates;
+        if height.depends(&|x| coordinates.iter().any(|c| c == x)) {
+            self.out
+                .holonomic
+                .push(Spanned::new(decl.span(), height.to_string()));
+        } else if let Some(h) = self.value(&height)
+            && h.abs() > 1e-12
+        {
+            self.cx.error(
+                structure(format!(
+                    "the ball does not touch the plane it rolls on: its height above it is {h} at the file's parameter values"
+                )),
+                Some(decl.span()),
+            );
+            return;
+        }
+        for row in rows {
+            self.out
+                .constraints
+                .push(Spanned::new(decl.span(), row.to_string()));
+        }
+    }
+
+    pub(super) fn knife_edge(&mut self, decl: &Spanned<KnifeEdgeDecl>) {
+        let d = decl.get_ref();
+        let (Some(blade), Some(n)) = (self.vector(&d.blade), self.vector(&d.normal)) else {
+            return;
+        };
+        if self.unit_vector(&n, d.normal.span()).is_none() {
+            return;
+        }
+        let Some(body) = self.find(&d.body) else {
+            return;
+        };
+        let across = cross(&n, &frames::apply(&body.rotation, &blade));
+        let row = dot(&across, &body.velocity);
+        if row.is_zero() {
+            self.cx.error(
+                structure("the blade is along the plane's normal: it constrains nothing"),
+                Some(d.blade.span()),
+            );
+            return;
+        }
+        self.out
+            .constraints
+            .push(Spanned::new(decl.span(), row.to_string()));
+    }
+
+    pub(super) fn wall(&mut self, w: &mut WallDecl, span: Range<usize>) {
+        let shapes = usize::from(w.plane.is_some())
+            + usize::from(w.sphere.is_some())
+            + usize::from(w.cylinder.is_some());
+        let Some(body_name) = w.body.clone() else {
+            if shapes > 0 || w.law.is_some() {
+                self.cx.error(
+                    structure("a wall given by shape (`plane`, `sphere`, `cylinder`, `law`) names the `body` that meets it"),
+                    Some(span),
+                );
+            }
+            return;
+        };
+        if shapes != 1 || w.surface.is_some() || !w.contact.is_empty() {
+            self.cx.error(
+                structure("a wall met by a body has one shape, `plane`, `sphere` or `cylinder`, and no `surface` or `contact` (they are derived)"),
+                Some(span),
+            );
+            return;
+        }
+        let rough = match w.law.as_ref().map(|l| l.get_ref().as_str()) {
+            None | Some("smooth") => false,
+            Some("rough") => true,
+            Some(other) => {
+                let at = w.law.as_ref().map(|l| l.span());
+                self.cx.error(
+                    structure(format!("the law is `smooth` or `rough`, not `{other}`")),
+                    at,
+                );
+                return;
+            }
+        };
+        // The geometry first (it needs `self` mutably), then the body.
+        enum Shape {
+            Plane(Vec3, Sym, usize),
+            Round(Vec3, Option<Vec3>, Sym),
+        }
+        let shape = if let Some(p) = &w.plane {
+            let Some((n, offset, k)) = self.plane(p) else {
+                return;
+            };
+            Shape::Plane(n, offset, k)
+        } else {
+            let (decl, cylinder): (&Spanned<RoundDecl>, bool) = match (&w.sphere, &w.cylinder) {
+                (Some(s), _) => (s, false),
+                (_, Some(c)) => (c, true),
+                _ => return,
+            };
+            let RoundDecl {
+                centre,
+                axis,
+                radius,
+            } = decl.get_ref();
+            let Some(c) = self.vector(centre) else { return };
+            let Some(big) = self.sym(radius) else { return };
+            let axis = match (axis, cylinder) {
+                (Some(a), true) => {
+                    let Some(a) = self.vector(a) else { return };
+                    if self.unit_vector(&a, decl.span()).is_none() {
+                        return;
+                    }
+                    Some(a)
+                }
+                (None, false) => None,
+                _ => {
+                    self.cx.error(
+                        structure("a cylinder has `axis`, a unit vector; a sphere has none"),
+                        Some(decl.span()),
+                    );
+                    return;
+                }
+            };
+            Shape::Round(c, axis, big)
+        };
+        let Some(body) = self.find(&body_name) else {
+            return;
+        };
+        let r = body.radius.clone().unwrap_or(int(0));
+        let (surface, offset, k) = match &shape {
+            Shape::Plane(n, offset, k) => (
+                sub(sub(dot(n, &body.position), offset.clone()), r.clone()),
+                scale(&mul([int(-1), r.clone()]), n),
+                Some(*k),
+            ),
+            Shape::Round(c, axis, big) => {
+                let mut d = minus(&body.position, c);
+                if let Some(a) = axis {
+                    d = minus(&d, &scale(&dot(&d, a), a));
+                }
+                let reach = sub(big.clone(), r.clone());
+                let f = div(
+                    sub(square(reach.clone()), dot(&d, &d)),
+                    mul([int(2), reach.clone()]),
+                );
+                // On the wall |d| = R − r: the contact point is r d/(R − r) away.
+                (f, scale(&div(r.clone(), reach), &d), None)
+            }
+        };
+        let rows = if rough {
+            if body.radius.is_none() {
+                self.cx.error(
+                    structure(format!(
+                        "a rough wall holds the contact point of the body's sphere; body `{}` has no `radius`",
+                        body_name.get_ref()
+                    )),
+                    w.law.as_ref().map(|l| l.span()),
+                );
+                return;
+            }
+            Self::no_slip(&body, &offset, k)
+        } else {
+            Vec::new()
+        };
+        w.surface = Some(Spanned::new(span.clone(), surface.to_string()));
+        w.contact = rows
+            .into_iter()
+            .map(|r| Spanned::new(span.clone(), r.to_string()))
+            .collect();
+    }
+}

@@ -1,0 +1,394 @@
+//! The bodies layer: a model file may describe rigid bodies, fields,
+//! rolling and knife-edge constraints and walls by shape and law, instead of
+//! T, V and the rows by hand. This stage runs on the file's shape before
+//! validation and writes what it derives into the same places a hand-written
+//! file fills ([definitions], [dynamics], each wall's `surface` and
+//! `contact`), each text carrying the span of the declaration it came from,
+//! so that everything after it (validation, derivation, both back ends)
+//! takes a body model exactly as the equivalent hand-written one.
+//!
+//! What is derived, for a body with centre S(q), mass m, inertia I about the
+//! centre in the body frame and attitude R(q):
+//! - the centre's velocity Ṡ = Σ ∂S/∂qᵢ q̇ᵢ and the angular velocity ω
+//!   (fixed frame) and Ω (body frame), from the attitude (`frames.rs`), as
+//!   definitions `{body}_vx` … and `{body}_wx` … (`{body}_w1` … in the body
+//!   frame) where a component is more than a name;
+//! - T = ½ m |Ṡ|² + ½ Ωᵀ I Ω (½ J |ω|² for a ball). For a quaternion, its
+//!   norm is a holonomic constraint and 2 tr(I)/3 (e · ė)² is added to T: it
+//!   vanishes to second order on |e| = 1 and makes G positive definite (for
+//!   a ball the sum is 2 J |ė|² on |e| = 1, which is what is written);
+//! - V = −Σ m g · S for uniform gravity g;
+//! - a ball rolling on a plane: its contact point C = S − r n at rest, as
+//!   the two rows Ċ · eᵢ across the normal's largest component, and the
+//!   height n · S − offset − r = 0 as a holonomic constraint where it varies;
+//! - a knife edge: (n × R b) · Ṡ = 0 for the blade b on the plane of normal n;
+//! - a wall by shape: the surface f, the signed distance of the body's
+//!   contact sphere (radius r, 0 for a point) to the plane, or, from inside
+//!   a sphere or cylinder of radius R, ((R − r)² − d²)/(2(R − r)) with d the
+//!   centre's distance to the centre or axis, which has the distance's zero
+//!   set, side and gradient on the wall; `rough` adds the contact point's
+//!   velocity as contact rows (the paper's no-slip rows), `smooth` none.
+
+mod body;
+mod contact;
+mod frames;
+mod sym;
+
+use std::collections::{HashMap, HashSet};
+use std::ops::Range;
+
+use toml::Spanned;
+
+use super::expr::parse;
+use super::file::{Dynamics, File, Number};
+use crate::diag::{Collector, ErrorKind};
+use frames::Vec3;
+use sym::{Sym, add, mul, name};
+
+/// Expands the file's bodies into definitions, T, V, rows and surfaces.
+pub(super) fn expand(file: &mut File, cx: &mut Collector) {
+    if file.body.is_empty() {
+        refuse_without_bodies(file, cx);
+        return;
+    }
+    let Some(coordinates) = file.coordinates.as_ref() else {
+        let at = file.body[0].span();
+        cx.error(
+            structure("bodies move with coordinates: declare [coordinates]"),
+            Some(at),
+        );
+        return;
+    };
+    let names: Vec<String> = coordinates
+        .get_ref()
+        .names
+        .iter()
+        .map(|n| n.get_ref().clone())
+        .collect();
+    let rates: Vec<String> = match &coordinates.get_ref().velocities {
+        Some(v) => v.iter().map(|n| n.get_ref().clone()).collect(),
+        None => names.iter().map(|n| format!("{n}_dot")).collect(),
+    };
+    let mut layer = Layer {
+        cx,
+        values: parameter_values(file),
+        definitions: user_definitions(file),
+        declared: declared_names(file),
+        coordinates: names,
+        rates,
+        out: Derived::default(),
+        bodies: HashMap::new(),
+    };
+    let gravity = file
+        .fields
+        .as_ref()
+        .and_then(|f| f.get_ref().gravity.as_ref())
+        .and_then(|g| layer.vector(g));
+    for decl in &file.body {
+        layer.body(decl, gravity.as_ref());
+    }
+    for decl in &file.rolling {
+        layer.rolling(decl);
+    }
+    for decl in &file.knife_edge {
+        layer.knife_edge(decl);
+    }
+    for decl in &mut file.wall {
+        let span = decl.span();
+        layer.wall(decl.get_mut(), span);
+    }
+    let out = layer.out;
+    for (n, text) in out.definitions {
+        file.definitions.insert(n, text);
+    }
+    let body_span = file.body[0].span();
+    let dynamics = file
+        .dynamics
+        .get_or_insert_with(|| Spanned::new(body_span.clone(), Dynamics::default()))
+        .get_mut();
+    let join = |own: Option<&Spanned<String>>, derived: Vec<String>| -> Option<Spanned<String>> {
+        let derived = derived.join(" + ");
+        match (own, derived.is_empty()) {
+            (own, true) => own.cloned(),
+            (Some(own), false) => Some(Spanned::new(
+                own.span(),
+                format!("{} + {derived}", own.get_ref()),
+            )),
+            (None, false) => Some(Spanned::new(body_span.clone(), derived)),
+        }
+    };
+    dynamics.kinetic_energy = join(dynamics.kinetic_energy.as_ref(), out.kinetic);
+    dynamics.potential = join(dynamics.potential.as_ref(), out.potential);
+    dynamics.holonomic.extend(out.holonomic);
+    dynamics.constraints.extend(out.constraints);
+}
+
+/// What the layer derives, text by text with its declaration's span.
+#[derive(Default)]
+struct Derived {
+    definitions: Vec<(Spanned<String>, Spanned<String>)>,
+    kinetic: Vec<String>,
+    potential: Vec<String>,
+    holonomic: Vec<Spanned<String>>,
+    constraints: Vec<Spanned<String>>,
+}
+
+/// A body as the later declarations use it.
+#[derive(Clone)]
+struct Body {
+    position: Vec3,
+    velocity: Vec3,
+    /// ω in the fixed frame (definition names where compound).
+    omega: Vec3,
+    rotation: frames::Mat3,
+    radius: Option<Sym>,
+}
+
+struct Layer<'a> {
+    cx: &'a mut Collector,
+    /// Parameter values from the file, for the checks that need numbers.
+    values: HashMap<String, f64>,
+    /// The file's definitions, to be substituted into positions and angles.
+    definitions: HashMap<String, Sym>,
+    /// Every name the file declares.
+    declared: HashSet<String>,
+    coordinates: Vec<String>,
+    rates: Vec<String>,
+    out: Derived,
+    bodies: HashMap<String, Body>,
+}
+
+fn structure(message: impl Into<String>) -> ErrorKind {
+    ErrorKind::Structure(message.into())
+}
+
+/// The text of a number or expression of the file.
+fn text_of(n: &Number) -> String {
+    match n {
+        Number::Int(i) => i.to_string(),
+        Number::Float(f) => format!("{f}"),
+        Number::Text(t) => t.clone(),
+    }
+}
+
+impl Layer<'_> {
+    /// An expression of the file, definitions substituted.
+    fn sym(&mut self, n: &Spanned<Number>) -> Option<Sym> {
+        self.sym_text(&text_of(n.get_ref()), n.span())
+    }
+
+    fn sym_text(&mut self, text: &str, span: Range<usize>) -> Option<Sym> {
+        match parse(text) {
+            Ok(node) => Some(Sym::from_node(&node, &self.definitions)),
+            Err(e) => {
+                self.cx.error(ErrorKind::Syntax(e.message), Some(span));
+                None
+            }
+        }
+    }
+
+    /// A vector of three expressions.
+    fn vector(&mut self, v: &Spanned<Vec<Spanned<Number>>>) -> Option<Vec3> {
+        if v.get_ref().len() != 3 {
+            self.cx.error(
+                structure(format!(
+                    "a vector has three components (x, y, z); this one has {}",
+                    v.get_ref().len()
+                )),
+                Some(v.span()),
+            );
+            return None;
+        }
+        let parts: Vec<Sym> = v
+            .get_ref()
+            .iter()
+            .map(|c| self.sym(c))
+            .collect::<Option<_>>()?;
+        Some(std::array::from_fn(|i| parts[i].clone()))
+    }
+
+    /// Its value at the file's parameter values, where it has one.
+    fn value(&self, s: &Sym) -> Option<f64> {
+        s.value(&|n| self.values.get(n).copied())
+    }
+
+    fn is_coordinate(&self, n: &str) -> bool {
+        self.coordinates.iter().any(|c| c == n)
+    }
+
+    /// The time derivative of an expression of the coordinates.
+    fn rate(&self, s: &Sym) -> Sym {
+        add(self
+            .coordinates
+            .iter()
+            .zip(&self.rates)
+            .map(|(q, v)| mul([s.derivative(q), name(v)])))
+    }
+
+    /// Refuses an expression that should depend on the coordinates only.
+    fn positional(&mut self, s: &Sym, what: &str, span: Range<usize>) -> bool {
+        let rates = &self.rates;
+        if s.depends(&|n| rates.iter().any(|v| v == n)) {
+            self.cx.error(
+                structure(format!(
+                    "{what} depends on a velocity; it is a function of the coordinates"
+                )),
+                Some(span),
+            );
+            return false;
+        }
+        true
+    }
+
+    /// `value` as a definition `{body}_{suffix}` where it is more than a
+    /// name or a number, so that T and the rows read like hand-written ones.
+    fn named(&mut self, value: Sym, body: &Spanned<String>, suffix: &str, what: &str) -> Sym {
+        if matches!(value, Sym::Name(_) | Sym::Num(_)) {
+            return value;
+        }
+        let n = format!("{}_{suffix}", body.get_ref());
+        if self.declared.contains(&n) {
+            self.cx.error(
+                structure(format!(
+                    "body `{}` names {what} `{n}`, a name the file already declares",
+                    body.get_ref()
+                )),
+                Some(body.span()),
+            );
+        }
+        self.declared.insert(n.clone());
+        self.out.definitions.push((
+            Spanned::new(body.span(), n.clone()),
+            Spanned::new(body.span(), value.to_string()),
+        ));
+        name(&n)
+    }
+}
+
+/// Without bodies, the declarations that need them are refused.
+fn refuse_without_bodies(file: &File, cx: &mut Collector) {
+    let mut spans: Vec<Range<usize>> = file.rolling.iter().map(|r| r.span()).collect();
+    spans.extend(file.knife_edge.iter().map(|k| k.span()));
+    spans.extend(file.fields.iter().map(|f| f.span()));
+    spans.extend(
+        file.wall
+            .iter()
+            .filter(|w| {
+                let w = w.get_ref();
+                w.body.is_some()
+                    || w.plane.is_some()
+                    || w.sphere.is_some()
+                    || w.cylinder.is_some()
+                    || w.law.is_some()
+            })
+            .map(|w| w.span()),
+    );
+    for at in spans {
+        cx.error(
+            structure("this declaration acts on bodies, and the file declares no [[body]]"),
+            Some(at),
+        );
+    }
+}
+
+/// The parameters' values as the file gives them (derived ones computed
+/// from the others), for the layer's numeric checks.
+fn parameter_values(file: &File) -> HashMap<String, f64> {
+    use super::file::ParamDecl;
+    let mut texts: Vec<(String, String)> = Vec::new();
+    for (n, d) in &file.parameters {
+        let value = match d.get_ref() {
+            ParamDecl::Full { value: Some(v), .. } | ParamDecl::Bare(v) => text_of(v),
+            ParamDecl::Full { value: None, .. } => continue,
+        };
+        texts.push((n.get_ref().clone(), value));
+    }
+    let mut values = HashMap::new();
+    // Each pass computes at least one more, or stops.
+    for _ in 0..texts.len() {
+        let before = values.len();
+        for (n, t) in &texts {
+            if values.contains_key(n) {
+                continue;
+            }
+            if let Some(v) = parse(t)
+                .ok()
+                .and_then(|node| node.value(&|x| values.get(x).copied()))
+            {
+                values.insert(n.clone(), v);
+            }
+        }
+        if values.len() == before {
+            break;
+        }
+    }
+    values
+}
+
+/// The file's definitions as expressions, each with the definitions it
+/// uses substituted (those in a cycle, or too large, left as names: the
+/// validator reports them).
+fn user_definitions(file: &File) -> HashMap<String, Sym> {
+    let parsed: Vec<(String, super::expr::Node)> = file
+        .definitions
+        .iter()
+        .filter_map(|(n, t)| {
+            parse(t.get_ref())
+                .ok()
+                .map(|node| (n.get_ref().clone(), node))
+        })
+        .collect();
+    let mut done: HashMap<String, Sym> = HashMap::new();
+    for _ in 0..parsed.len() {
+        let before = done.len();
+        for (n, node) in &parsed {
+            if done.contains_key(n) {
+                continue;
+            }
+            let mut ready = true;
+            node.visit_names(&mut |x, _| {
+                if parsed.iter().any(|(m, _)| m == x) && !done.contains_key(x) {
+                    ready = false;
+                }
+            });
+            if ready {
+                let s = Sym::from_node(node, &done);
+                if s.to_string().len() <= super::expr::MAX_LEN {
+                    done.insert(n.clone(), s);
+                }
+            }
+        }
+        if done.len() == before {
+            break;
+        }
+    }
+    done
+}
+
+/// Every name the file declares.
+fn declared_names(file: &File) -> HashSet<String> {
+    let mut out: HashSet<String> = file
+        .parameters
+        .keys()
+        .map(|n| n.get_ref().clone())
+        .collect();
+    out.extend(file.definitions.keys().map(|n| n.get_ref().clone()));
+    for names in [&file.coordinates, &file.velocities].into_iter().flatten() {
+        let names = names.get_ref();
+        out.extend(names.names.iter().map(|n| n.get_ref().clone()));
+        if let Some(v) = &names.velocities {
+            out.extend(v.iter().map(|n| n.get_ref().clone()));
+        }
+    }
+    if let Some(c) = &file.coordinates
+        && c.get_ref().velocities.is_none()
+    {
+        out.extend(
+            c.get_ref()
+                .names
+                .iter()
+                .map(|n| format!("{}_dot", n.get_ref())),
+        );
+    }
+    out
+}

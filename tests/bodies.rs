@@ -1,0 +1,404 @@
+//! The bodies layer (`[[body]]`, `[fields]`, `[[rolling]]`,
+//! `[[knife_edge]]`, walls by shape and law) against independent answers:
+//! - the built-in hand-written models, re-expressed as bodies in
+//!   `tests/bodies/`, derive to the same G, A, h, q̈, surfaces, P and
+//!   collision maps, exactly (symbolic equality), with the same operation
+//!   counts;
+//! - Chaplygin's ball (unequal principal moments) rolling into a rough wall,
+//!   its attitude written three ways (z-x-z and z-y-x angles, a unit
+//!   quaternion), moves the same to 1e-12 through three collisions: the
+//!   starting states are converted in this file from one rotation matrix and
+//!   one angular velocity, by formulas of its own.
+//!
+//! Uses the symbolic engine: run one test at a time (`RUST_TEST_THREADS=1`).
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use dalembert::runtime::prelude::*;
+use dalembert::runtime::simulate::{Simulator, State};
+use dalembert_codegen::derive::inspect::same;
+use dalembert_codegen::derive::{Geometry, Projection};
+use dalembert_codegen::interpret::Interpreted;
+use dalembert_codegen::{Derivation, derive};
+
+fn file(dir: &str, name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join(dir)
+        .join(format!("{name}.toml"))
+}
+
+fn derived(dir: &str, name: &str) -> Derivation {
+    derive(&file(dir, name)).unwrap_or_else(|e| panic!("{dir}/{name}: {e}"))
+}
+
+fn assert_same(what: &str, body: &[String], hand: &[String]) {
+    assert_eq!(body.len(), hand.len(), "{what}: {body:?} vs {hand:?}");
+    for (b, h) in body.iter().zip(hand) {
+        assert!(same(b, h).unwrap(), "{what}: `{b}` is not `{h}`");
+    }
+}
+
+#[test]
+fn bodies_give_the_hand_written_models() {
+    for name in [
+        "ball_wall_euler",
+        "ball_wall_quaternion",
+        "ball_bounce",
+        "puck",
+        "pendulum_wall",
+        "superball",
+    ] {
+        let b = derived("tests/bodies", name);
+        let h = derived("models", name);
+        assert_eq!(b.model.coordinates, h.model.coordinates, "{name}");
+        assert_eq!(b.model.velocities, h.model.velocities, "{name}");
+        for (i, (rb, rh)) in b.mass_matrix.iter().zip(&h.mass_matrix).enumerate() {
+            assert_same(&format!("{name}: G row {i}"), rb, rh);
+        }
+        assert_eq!(
+            b.constraint_rows.len(),
+            h.constraint_rows.len(),
+            "{name}: A"
+        );
+        for (i, (rb, rh)) in b.constraint_rows.iter().zip(&h.constraint_rows).enumerate() {
+            assert_same(&format!("{name}: A row {i}"), rb, rh);
+        }
+        assert_same(&format!("{name}: h(q)"), &b.holonomic, &h.holonomic);
+        match (&b.accelerations, &h.accelerations) {
+            (Some(qb), Some(qh)) => assert_same(&format!("{name}: q''"), qb, qh),
+            (None, None) => {}
+            _ => panic!("{name}: q'' in closed form for one and not the other"),
+        }
+        assert_eq!(b.walls.len(), h.walls.len(), "{name}: walls");
+        for (wb, wh) in b.walls.iter().zip(&h.walls) {
+            let what = format!("{name}, wall {}", wh.name);
+            assert_eq!(wb.name, wh.name);
+            match (&wb.geometry, &wh.geometry) {
+                (Geometry::Surface(fb), Geometry::Surface(fh)) => {
+                    assert!(same(fb, fh).unwrap(), "{what}: f = {fb}, not {fh}")
+                }
+                _ => panic!("{what}: geometry"),
+            }
+            match (&wb.projection, &wh.projection) {
+                (
+                    Projection::ClosedForm {
+                        projector: pb,
+                        collision: cb,
+                    },
+                    Projection::ClosedForm {
+                        projector: ph,
+                        collision: ch,
+                    },
+                ) => {
+                    for (i, (rb, rh)) in pb.iter().zip(ph).enumerate() {
+                        assert_same(&format!("{what}: P row {i}"), rb, rh);
+                    }
+                    assert_same(&format!("{what}: v+"), cb, ch);
+                }
+                (Projection::Structured, Projection::Structured) => {}
+                _ => panic!("{what}: P closed form for one and not the other"),
+            }
+        }
+        // The generated code costs what the hand-written model's does.
+        let (fb, fh) = (b.named_functions(), h.named_functions());
+        assert_eq!(
+            fb.iter().map(|(n, _)| n).collect::<Vec<_>>(),
+            fh.iter().map(|(n, _)| n).collect::<Vec<_>>(),
+            "{name}: functions"
+        );
+        for ((n, b), (_, h)) in fb.iter().zip(&fh) {
+            let (ob, oh) = (b.program.op_count().total(), h.program.op_count().total());
+            assert!(
+                ob as f64 <= 1.05 * oh as f64,
+                "{name}: {n} takes {ob} operations from bodies, {oh} by hand"
+            );
+        }
+    }
+}
+
+// --- Chaplygin's ball, three ways -------------------------------------------
+
+type M3 = [[f64; 3]; 3];
+
+fn mat(a: &M3, b: &M3) -> M3 {
+    std::array::from_fn(|i| std::array::from_fn(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum()))
+}
+
+fn transpose(a: &M3) -> M3 {
+    std::array::from_fn(|i| std::array::from_fn(|j| a[j][i]))
+}
+
+/// The rotation by `t` about axis `k`, and its derivative by `t`.
+fn rot(k: usize, t: f64) -> (M3, M3) {
+    let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+    let (c, s) = (t.cos(), t.sin());
+    let mut r = [[0.0; 3]; 3];
+    let mut d = [[0.0; 3]; 3];
+    r[k][k] = 1.0;
+    r[i][i] = c;
+    r[j][j] = c;
+    r[i][j] = -s;
+    r[j][i] = s;
+    d[i][i] = -s;
+    d[j][j] = -s;
+    d[i][j] = -c;
+    d[j][i] = c;
+    (r, d)
+}
+
+/// R = R_{a₁}(α₁) R_{a₂}(α₂) R_{a₃}(α₃), and the angle rates that give the
+/// fixed-frame angular velocity `w`: ω = Σ α̇ⱼ vee(∂R/∂αⱼ Rᵀ), solved.
+fn angle_rates(axes: [usize; 3], angles: [f64; 3], w: [f64; 3]) -> [f64; 3] {
+    let parts: Vec<(M3, M3)> = (0..3).map(|j| rot(axes[j], angles[j])).collect();
+    let r = mat(&mat(&parts[0].0, &parts[1].0), &parts[2].0);
+    let columns: Vec<[f64; 3]> = (0..3)
+        .map(|j| {
+            let f = |k: usize| if k == j { parts[k].1 } else { parts[k].0 };
+            let d = mat(&mat(&f(0), &f(1)), &f(2));
+            let s = mat(&d, &transpose(&r));
+            [s[2][1], s[0][2], s[1][0]]
+        })
+        .collect();
+    // Cramer's rule on the 3×3 system.
+    let det = |c: [[f64; 3]; 3]| {
+        c[0][0] * (c[1][1] * c[2][2] - c[2][1] * c[1][2])
+            - c[1][0] * (c[0][1] * c[2][2] - c[2][1] * c[0][2])
+            + c[2][0] * (c[0][1] * c[1][2] - c[1][1] * c[0][2])
+    };
+    let m = [columns[0], columns[1], columns[2]];
+    let d = det(m);
+    std::array::from_fn(|j| {
+        let mut mj = m;
+        mj[j] = w;
+        det(mj) / d
+    })
+}
+
+/// The starting state of Chaplygin's ball in each attitude convention: at
+/// x = 3/2, y = 0, attitude R₀ = R_z(0.3) R_x(1.1) R_z(−0.4), angular
+/// velocity ω (fixed frame), rolling (ẋ = r ω_y, ẏ = −r ω_x).
+fn chaplygin_start(convention: &str, r: f64) -> (Vec<f64>, Vec<f64>) {
+    let w = [0.7, -0.5, 1.3];
+    let zxz = [0.3, 1.1, -0.4];
+    let r0 = {
+        let p = |k, t| rot(k, t).0;
+        mat(&mat(&p(2, zxz[0]), &p(0, zxz[1])), &p(2, zxz[2]))
+    };
+    let centre = (vec![1.5, 0.0], vec![r * w[1], -r * w[0]]);
+    let (attitude, rates): (Vec<f64>, Vec<f64>) = match convention {
+        "zxz" => {
+            let a = [
+                r0[0][2].atan2(-r0[1][2]),
+                r0[2][2].acos(),
+                r0[2][0].atan2(r0[2][1]),
+            ];
+            (a.to_vec(), angle_rates([2, 0, 2], a, w).to_vec())
+        }
+        "zyx" => {
+            let a = [
+                r0[1][0].atan2(r0[0][0]),
+                -r0[2][0].asin(),
+                r0[2][1].atan2(r0[2][2]),
+            ];
+            (a.to_vec(), angle_rates([2, 1, 0], a, w).to_vec())
+        }
+        "quaternion" => {
+            let e0 = 0.5 * (1.0 + r0[0][0] + r0[1][1] + r0[2][2]).sqrt();
+            let v = [
+                (r0[2][1] - r0[1][2]) / (4.0 * e0),
+                (r0[0][2] - r0[2][0]) / (4.0 * e0),
+                (r0[1][0] - r0[0][1]) / (4.0 * e0),
+            ];
+            // ė = ½ (0, ω) ⊗ e.
+            let d0 = -0.5 * (w[0] * v[0] + w[1] * v[1] + w[2] * v[2]);
+            let cross = [
+                w[1] * v[2] - w[2] * v[1],
+                w[2] * v[0] - w[0] * v[2],
+                w[0] * v[1] - w[1] * v[0],
+            ];
+            let dv: Vec<f64> = (0..3).map(|i| 0.5 * (e0 * w[i] + cross[i])).collect();
+            let mut rates = vec![d0];
+            rates.extend(dv);
+            (vec![e0, v[0], v[1], v[2]], rates)
+        }
+        other => panic!("{other}"),
+    };
+    let mut q = centre.0;
+    q.extend(attitude);
+    let mut v = centre.1;
+    v.extend(rates);
+    (q, v)
+}
+
+/// The centre's (x, y, ẋ, ẏ) at the end of each collision and at `t_end`,
+/// with the collision instants.
+fn chaplygin_run<const N: usize>(convention: &str, t_end: f64) -> (Vec<f64>, Vec<[f64; 4]>) {
+    let d = derived("tests/bodies", &format!("chaplygin_{convention}"));
+    let m = Interpreted::<N>::new(&d).unwrap_or_else(|e| panic!("{convention}: {e}"));
+    let r = 0.5;
+    let (q, v) = chaplygin_start(convention, r);
+    let q: [f64; N] = q.try_into().unwrap_or_else(|_| panic!("{convention}: q"));
+    let v: [f64; N] = v.try_into().unwrap_or_else(|_| panic!("{convention}: v"));
+    let e0 = m.energy(&q, &v);
+    let mut sim = Simulator::new(&m, State { t: 0.0, q, v }, common::dormand_prince(1e-13))
+        .unwrap_or_else(|e| panic!("{convention}: {e:?}"));
+    let mut instants = Vec::new();
+    let mut states = Vec::new();
+    let mut last = None;
+    sim.run(t_end, |s| {
+        if let Some(c) = &s.collision {
+            instants.push(c.t);
+            states.push([s.state.q[0], s.state.q[1], s.state.v[0], s.state.v[1]]);
+        }
+        last = Some(s.state);
+        true
+    })
+    .unwrap_or_else(|e| panic!("{convention}: {e:?}"));
+    let end = last.unwrap();
+    assert!((end.t - t_end).abs() < 1e-12);
+    states.push([end.q[0], end.q[1], end.v[0], end.v[1]]);
+    let e1 = m.energy(&end.q, &end.v);
+    assert!(
+        (e1 - e0).abs() < 1e-10 * e0.abs(),
+        "{convention}: energy {e0} → {e1}"
+    );
+    (instants, states)
+}
+
+#[test]
+fn attitude_conventions_give_the_same_motion() {
+    let t_end = 12.0;
+    let (ti, si) = chaplygin_run::<5>("zxz", t_end);
+    let others = [
+        ("zyx", chaplygin_run::<5>("zyx", t_end)),
+        ("quaternion", chaplygin_run::<6>("quaternion", t_end)),
+    ];
+    assert!(ti.len() >= 3, "only {} collisions with the wall", ti.len());
+    for (name, (t, s)) in &others {
+        assert_eq!(t.len(), ti.len(), "{name}: collisions {t:?} vs {ti:?}");
+        for (a, b) in t.iter().zip(&ti) {
+            assert!(
+                (a - b).abs() < 1e-12,
+                "{name}: collision at {a}, z-x-z at {b}"
+            );
+        }
+        for (a, b) in s.iter().zip(&si) {
+            for k in 0..4 {
+                assert!((a[k] - b[k]).abs() < 1e-12, "{name}: {a:?}, z-x-z {b:?}");
+            }
+        }
+    }
+}
+
+// --- Curved walls -------------------------------------------------------------
+
+/// M(angles) with ω = M α̇ for z-x-z angles, from the rotation's derivatives.
+fn zxz_rates_matrix(angles: [f64; 3]) -> M3 {
+    let parts: Vec<(M3, M3)> = (0..3).map(|j| rot([2, 0, 2][j], angles[j])).collect();
+    let r = mat(&mat(&parts[0].0, &parts[1].0), &parts[2].0);
+    let columns: Vec<[f64; 3]> = (0..3)
+        .map(|j| {
+            let f = |k: usize| if k == j { parts[k].1 } else { parts[k].0 };
+            let s = mat(&mat(&mat(&f(0), &f(1)), &f(2)), &transpose(&r));
+            [s[2][1], s[0][2], s[1][0]]
+        })
+        .collect();
+    std::array::from_fn(|i| std::array::from_fn(|j| columns[j][i]))
+}
+
+/// The collision law in the Cartesian velocities (v, ω) of a ball (mass m,
+/// moment J, radius r) touching a wall at the point r u from its centre:
+/// smooth, v's component along u reversed; rough, (I − 2P) with B the
+/// contact point's velocity v + ω × r u and G = diag(m, m, m, J, J, J).
+fn contact_law(rough: bool, (m, j, r): (f64, f64, f64), u: [f64; 3], x: [f64; 6]) -> [f64; 6] {
+    use nalgebra::{DMatrix, DVector};
+    let rows: Vec<[f64; 6]> = if rough {
+        // Row k of B: e_k · (v + ω × r u) = v_k + r (u × e_k) · ω.
+        (0..3)
+            .map(|k| {
+                let e: [f64; 3] = std::array::from_fn(|i| f64::from(u8::from(i == k)));
+                let c = [
+                    u[1] * e[2] - u[2] * e[1],
+                    u[2] * e[0] - u[0] * e[2],
+                    u[0] * e[1] - u[1] * e[0],
+                ];
+                [e[0], e[1], e[2], r * c[0], r * c[1], r * c[2]]
+            })
+            .collect()
+    } else {
+        vec![[u[0], u[1], u[2], 0.0, 0.0, 0.0]]
+    };
+    let b = DMatrix::from_fn(rows.len(), 6, |i, k| rows[i][k]);
+    let g_inv = DMatrix::from_diagonal(&DVector::from_vec(vec![
+        1.0 / m,
+        1.0 / m,
+        1.0 / m,
+        1.0 / j,
+        1.0 / j,
+        1.0 / j,
+    ]));
+    let gram = &b * &g_inv * b.transpose();
+    let p = &g_inv * b.transpose() * gram.try_inverse().unwrap() * &b;
+    let v = DVector::from_row_slice(&x);
+    let after = &v - 2.0 * (p * &v);
+    std::array::from_fn(|i| after[i])
+}
+
+/// A ball inside a rough sphere and a smooth cylinder (walls derived from
+/// their shapes): at random points of each wall, the equator of the sphere
+/// among them, and random velocities, the model's collision map equals the
+/// contact law written in Cartesian velocities, to 1e-12.
+#[test]
+fn curved_walls_follow_the_contact_law() {
+    let d = derived("tests/bodies", "ball_in_bowl");
+    let model = Interpreted::<6>::new(&d).unwrap_or_else(|e| panic!("{e}"));
+    let p = |n: &str| model.parameter_named(n).unwrap();
+    let (m, j, r, big, tube) = (p("m"), p("J"), p("r"), p("R"), p("rt"));
+    let mut seed = 7u64;
+    let mut rnd = || 2.0 * common::lcg(&mut seed) - 1.0;
+    for case in 0..40 {
+        for &wall in model.walls() {
+            let name = model.wall_name(wall).to_string();
+            // The direction u from the centre to the contact point.
+            let u: [f64; 3] = if name == "bowl" {
+                let mut u = [rnd(), rnd(), if case % 4 == 0 { 0.0 } else { rnd() }];
+                let n = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+                u.iter_mut().for_each(|x| *x /= n);
+                u
+            } else {
+                let a = std::f64::consts::PI * rnd();
+                [a.cos(), a.sin(), 0.0]
+            };
+            let reach = if name == "bowl" { big - r } else { tube - r };
+            let height = if name == "bowl" { 0.0 } else { rnd() };
+            let centre = [reach * u[0], reach * u[1], reach * u[2] + height];
+            let angles = [rnd(), 1.0 + 0.5 * rnd(), rnd()];
+            let q = [
+                centre[0], centre[1], centre[2], angles[0], angles[1], angles[2],
+            ];
+            assert!(
+                model.surface(wall, &q).abs() < 1e-12,
+                "{name}: off the wall"
+            );
+            let v: [f64; 6] = std::array::from_fn(|_| rnd());
+            let after = model.collide(wall, &q, &v);
+            let omega = |v: &[f64; 6]| {
+                let mm = zxz_rates_matrix(angles);
+                let rates = [v[3], v[4], v[5]];
+                let w: [f64; 3] =
+                    std::array::from_fn(|i| (0..3).map(|k| mm[i][k] * rates[k]).sum());
+                [v[0], v[1], v[2], w[0], w[1], w[2]]
+            };
+            let expected = contact_law(name == "bowl", (m, j, r), u, omega(&v));
+            let got = omega(&after);
+            for i in 0..6 {
+                assert!(
+                    (got[i] - expected[i]).abs() < 1e-12 * (1.0 + expected[i].abs()),
+                    "{name}, case {case}: {got:?} vs {expected:?}"
+                );
+            }
+        }
+    }
+}
