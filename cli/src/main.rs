@@ -325,6 +325,13 @@ fn print_derivation(d: &Derivation) -> bool {
     if !m.coordinates.is_empty() {
         println!("coordinates ({})", m.coordinates.join(", "));
     }
+    if !m.from_bodies.is_empty() {
+        println!("derived from the bodies (line of the declaration):");
+        for x in &m.from_bodies {
+            let (line, _) = dalembert_codegen::diag::line_col(&m.source, x.span.start);
+            println!("  {} = {}   (line {line})", x.what, x.text);
+        }
+    }
     print_matrix("G =", &d.mass_matrix);
     if d.constraint_rows.is_empty() {
         println!("A: no constraints");

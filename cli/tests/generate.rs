@@ -116,3 +116,33 @@ fn tangents_past_the_bound_are_left_out() {
     assert!(code.contains("pub fn accelerations("));
     assert!(!code.contains("accelerations_tangent"));
 }
+
+/// `derive` of a model written with bodies shows what the bodies layer
+/// derived, each with the line of its declaration, before G.
+#[test]
+fn derive_shows_what_the_bodies_derive() {
+    let model =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/bodies/ball_wall_euler.toml");
+    let out = Command::new(env!("CARGO_BIN_EXE_dalembert"))
+        .arg("derive")
+        .arg(model)
+        .output()
+        .expect("the CLI runs");
+    assert!(out.status.success(), "{out:?}");
+    let text = String::from_utf8(out.stdout).unwrap();
+    let shown = text.find("derived from the bodies").expect(&text);
+    assert!(shown < text.find("G =").unwrap(), "{text}");
+    for line in [
+        "  ball_wy = theta_dot*sin(phi) - psi_dot*cos(phi)*sin(theta)   (line 16)",
+        "  T = J*(ball_wx^2 + ball_wy^2 + ball_wz^2)/2   (line 15)",
+        "  V = m*(a*x + g*r)   (line 15)",
+        "  row of A = x_dot - ball_wy*r   (line 26)",
+        "  wall `wall` surface = x - r   (line 30)",
+        "  wall `wall` contact row = y_dot - ball_wz*r   (line 30)",
+    ] {
+        assert!(
+            text.lines().any(|l| l == line),
+            "no line `{line}` in\n{text}"
+        );
+    }
+}

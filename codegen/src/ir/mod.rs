@@ -7,6 +7,7 @@
 
 mod bodies;
 pub mod expr;
+pub use bodies::FromBodies;
 mod file;
 mod limits;
 mod names;
@@ -233,6 +234,9 @@ pub struct Model {
     /// The same state as expressions of the parameters, slot by slot
     /// (`None`: zero), so that it follows parameters set later.
     pub initial_state: Vec<Option<Expr>>,
+    /// What the bodies layer derived (T, V, rows, surfaces, definitions),
+    /// in the file's order; empty for a file without `[[body]]`.
+    pub from_bodies: Vec<FromBodies>,
     /// The model file's text.
     pub source: String,
     /// The model file.
@@ -322,13 +326,14 @@ pub fn parse(path: &Path, text: &str) -> Result<Model, ModelErrors> {
             return Err(cx.into_errors());
         }
     };
-    bodies::expand(&mut file, &mut cx);
+    let from_bodies = bodies::expand(&mut file, &mut cx);
     let model = Validator {
         cx: &mut cx,
         text,
         names: HashMap::new(),
     }
     .model(path, file);
+    let model = model.map(|m| Model { from_bodies, ..m });
     if let Some(m) = &model {
         check_names(m, &mut cx);
         check_degrees(m, &mut cx);

@@ -127,6 +127,7 @@ impl Validator<'_> {
             projector,
             initial,
             initial_state,
+            from_bodies: Vec::new(),
             source: self.text.to_string(),
             file: path.to_path_buf(),
         })

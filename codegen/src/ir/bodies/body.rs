@@ -157,15 +157,20 @@ impl Layer<'_> {
         }
         for t in kinetic {
             if !t.is_zero() {
-                self.out.kinetic.push(t.to_string());
+                self.out
+                    .kinetic
+                    .push(Spanned::new(decl.span(), t.to_string()));
             }
         }
 
         // V.
         if let Some(g) = gravity {
-            let v = mul([int(-1), mass.clone(), dot(g, &position)]);
+            let down: Vec3 = std::array::from_fn(|i| mul([int(-1), g[i].clone()]));
+            let v = mul([mass.clone(), dot(&down, &position)]);
             if !v.is_zero() {
-                self.out.potential.push(v.to_string());
+                self.out
+                    .potential
+                    .push(Spanned::new(decl.span(), v.to_string()));
             }
         }
         let rotation = attitude.rotation();

@@ -46,10 +46,10 @@ use frames::Vec3;
 use sym::{Sym, add, mul, name};
 
 /// Expands the file's bodies into definitions, T, V, rows and surfaces.
-pub(super) fn expand(file: &mut File, cx: &mut Collector) {
+pub(super) fn expand(file: &mut File, cx: &mut Collector) -> Vec<FromBodies> {
     if file.body.is_empty() {
         refuse_without_bodies(file, cx);
-        return;
+        return Vec::new();
     }
     let Some(coordinates) = file.coordinates.as_ref() else {
         let at = file.body[0].span();
@@ -57,7 +57,7 @@ pub(super) fn expand(file: &mut File, cx: &mut Collector) {
             structure("bodies move with coordinates: declare [coordinates]"),
             Some(at),
         );
-        return;
+        return Vec::new();
     };
     let names: Vec<String> = coordinates
         .get_ref()
@@ -98,6 +98,38 @@ pub(super) fn expand(file: &mut File, cx: &mut Collector) {
         layer.wall(decl.get_mut(), span);
     }
     let out = layer.out;
+    let shown = |what: &str, t: &Spanned<String>| FromBodies {
+        what: what.to_string(),
+        text: t.get_ref().clone(),
+        span: t.span(),
+    };
+    let mut record: Vec<FromBodies> = out
+        .definitions
+        .iter()
+        .map(|(n, t)| shown(n.get_ref(), t))
+        .collect();
+    record.extend(out.kinetic.iter().map(|t| shown("T", t)));
+    record.extend(out.potential.iter().map(|t| shown("V", t)));
+    record.extend(out.holonomic.iter().map(|t| shown("holonomic h", t)));
+    record.extend(out.constraints.iter().map(|t| shown("row of A", t)));
+    for w in file
+        .wall
+        .iter()
+        .map(|w| w.get_ref())
+        .filter(|w| w.body.is_some())
+    {
+        let name = w.name.get_ref();
+        record.extend(
+            w.surface
+                .iter()
+                .map(|t| shown(&format!("wall `{name}` surface"), t)),
+        );
+        record.extend(
+            w.contact
+                .iter()
+                .map(|t| shown(&format!("wall `{name}` contact row"), t)),
+        );
+    }
     for (n, text) in out.definitions {
         file.definitions.insert(n, text);
     }
@@ -106,7 +138,8 @@ pub(super) fn expand(file: &mut File, cx: &mut Collector) {
         .dynamics
         .get_or_insert_with(|| Spanned::new(body_span.clone(), Dynamics::default()))
         .get_mut();
-    let join = |own: Option<&Spanned<String>>, derived: Vec<String>| -> Option<Spanned<String>> {
+    let join = |own: Option<&Spanned<String>>, derived: Vec<Spanned<String>>| {
+        let derived: Vec<String> = derived.into_iter().map(|t| t.into_inner()).collect();
         let derived = derived.join(" + ");
         match (own, derived.is_empty()) {
             (own, true) => own.cloned(),
@@ -121,14 +154,28 @@ pub(super) fn expand(file: &mut File, cx: &mut Collector) {
     dynamics.potential = join(dynamics.potential.as_ref(), out.potential);
     dynamics.holonomic.extend(out.holonomic);
     dynamics.constraints.extend(out.constraints);
+    record
+}
+
+/// One thing the bodies layer derived, for `derive` to show: what it is
+/// (`T`, `constraint`, `wall floor: contact`, …), its text, and the span
+/// of the declaration it came from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FromBodies {
+    /// What it is.
+    pub what: String,
+    /// The expression, in the model language.
+    pub text: String,
+    /// Where its declaration is in the file.
+    pub span: Range<usize>,
 }
 
 /// What the layer derives, text by text with its declaration's span.
 #[derive(Default)]
 struct Derived {
     definitions: Vec<(Spanned<String>, Spanned<String>)>,
-    kinetic: Vec<String>,
-    potential: Vec<String>,
+    kinetic: Vec<Spanned<String>>,
+    potential: Vec<Spanned<String>>,
     holonomic: Vec<Spanned<String>>,
     constraints: Vec<Spanned<String>>,
 }
