@@ -72,6 +72,10 @@ impl Validator<'_> {
         };
         let kinetic_energy = match &dynamics.kinetic_energy {
             Some(t) => self.expr(t),
+            // Bodies that gave no T: the bodies layer has said why.
+            None if !file.body.is_empty() => {
+                self.expr(&Spanned::new(dyn_span.clone(), "0".to_string()))
+            }
             None => {
                 self.cx.error(
                     ErrorKind::Structure(

@@ -69,10 +69,23 @@ pub(super) fn expand(file: &mut File, cx: &mut Collector) -> Vec<FromBodies> {
         Some(v) => v.iter().map(|n| n.get_ref().clone()).collect(),
         None => names.iter().map(|n| format!("{n}_dot")).collect(),
     };
+    let definitions = user_definitions(file);
+    let unexpanded = file
+        .definitions
+        .keys()
+        .map(|n| n.get_ref().clone())
+        .filter(|n| !definitions.contains_key(n))
+        .collect();
     let mut layer = Layer {
         cx,
         values: parameter_values(file),
-        definitions: user_definitions(file),
+        definitions,
+        unexpanded,
+        declared_bodies: file
+            .body
+            .iter()
+            .map(|b| b.get_ref().name.get_ref().clone())
+            .collect(),
         declared: declared_names(file),
         coordinates: names,
         rates,
@@ -199,6 +212,10 @@ struct Layer<'a> {
     definitions: HashMap<String, Sym>,
     /// Every name the file declares.
     declared: HashSet<String>,
+    /// The file's definitions left out of `definitions`.
+    unexpanded: HashSet<String>,
+    /// The names of every `[[body]]`, read or not.
+    declared_bodies: HashSet<String>,
     coordinates: Vec<String>,
     rates: Vec<String>,
     out: Derived,
@@ -226,7 +243,24 @@ impl Layer<'_> {
 
     fn sym_text(&mut self, text: &str, span: Range<usize>) -> Option<Sym> {
         match parse(text) {
-            Ok(node) => Some(Sym::from_node(&node, &self.definitions)),
+            Ok(node) => {
+                let mut left_out = None;
+                node.visit_names(&mut |x, _| {
+                    if self.unexpanded.contains(x) {
+                        left_out.get_or_insert_with(|| x.to_string());
+                    }
+                });
+                if let Some(x) = left_out {
+                    self.cx.error(
+                        structure(format!(
+                            "this uses definition `{x}`, which the bodies layer does not substitute: it is in a cycle, or larger than {MAX_SUBSTITUTED_SIZE} terms or {MAX_SUBSTITUTED_DEPTH} levels once the definitions it uses are substituted"
+                        )),
+                        Some(span),
+                    );
+                    return None;
+                }
+                Some(Sym::from_node(&node, &self.definitions))
+            }
             Err(e) => {
                 self.cx.error(ErrorKind::Syntax(e.message), Some(span));
                 None
@@ -372,11 +406,19 @@ fn parameter_values(file: &File) -> HashMap<String, f64> {
     values
 }
 
+/// The most nodes, and the deepest nesting, of a definition the layer
+/// substitutes into positions and angles: far above a real model's, and
+/// small enough that differentiating what uses it stays cheap.
+const MAX_SUBSTITUTED_SIZE: u64 = 4096;
+const MAX_SUBSTITUTED_DEPTH: u64 = 128;
+
 /// The file's definitions as expressions, each with the definitions it
-/// uses substituted (those in a cycle, or too large, left as names: the
-/// validator reports them).
+/// uses substituted, in dependency order (Kahn's algorithm: linear in the
+/// definitions' size). Those in a cycle, or past the bounds above, are left
+/// out: an expression of the layer that uses one is refused
+/// ([`Layer::sym_text`]), and the validator reports cycles.
 fn user_definitions(file: &File) -> HashMap<String, Sym> {
-    let parsed: Vec<(String, super::expr::Node)> = file
+    let parsed: HashMap<String, super::expr::Node> = file
         .definitions
         .iter()
         .filter_map(|(n, t)| {
@@ -385,28 +427,50 @@ fn user_definitions(file: &File) -> HashMap<String, Sym> {
                 .map(|node| (n.get_ref().clone(), node))
         })
         .collect();
-    let mut done: HashMap<String, Sym> = HashMap::new();
-    for _ in 0..parsed.len() {
-        let before = done.len();
-        for (n, node) in &parsed {
-            if done.contains_key(n) {
-                continue;
+    // Which definitions each one uses, and who uses it.
+    let mut waiting: HashMap<&str, usize> = HashMap::new();
+    let mut users: HashMap<&str, Vec<&str>> = HashMap::new();
+    for (n, node) in &parsed {
+        let mut uses: HashSet<&str> = HashSet::new();
+        node.visit_names(&mut |x, _| {
+            if let Some((m, _)) = parsed.get_key_value(x) {
+                uses.insert(m.as_str());
             }
-            let mut ready = true;
-            node.visit_names(&mut |x, _| {
-                if parsed.iter().any(|(m, _)| m == x) && !done.contains_key(x) {
-                    ready = false;
-                }
-            });
-            if ready {
-                let s = Sym::from_node(node, &done);
-                if s.to_string().len() <= super::expr::MAX_LEN {
-                    done.insert(n.clone(), s);
-                }
-            }
+        });
+        waiting.insert(n.as_str(), uses.len());
+        for u in uses {
+            users.entry(u).or_default().push(n.as_str());
         }
-        if done.len() == before {
-            break;
+    }
+    let mut ready: Vec<&str> = waiting
+        .iter()
+        .filter(|(_, w)| **w == 0)
+        .map(|(n, _)| *n)
+        .collect();
+    let mut done: HashMap<String, Sym> = HashMap::new();
+    let mut sizes: HashMap<&str, (u64, u64)> = HashMap::new();
+    while let Some(n) = ready.pop() {
+        let node = &parsed[n];
+        // A name left out counts past the bounds, so what uses it is too.
+        let over = (MAX_SUBSTITUTED_SIZE + 1, MAX_SUBSTITUTED_DEPTH + 1);
+        let of = |x: &str| match (sizes.get(x), parsed.contains_key(x)) {
+            (Some(s), _) => *s,
+            (None, true) => over,
+            (None, false) => (1, 1),
+        };
+        let size = node.size(&|x| of(x).0);
+        let depth = node.depth(&|x| of(x).1);
+        if size <= MAX_SUBSTITUTED_SIZE && depth <= MAX_SUBSTITUTED_DEPTH {
+            sizes.insert(n, (size, depth));
+            done.insert(n.to_string(), Sym::from_node(node, &done));
+        }
+        for u in users.get(n).into_iter().flatten() {
+            if let Some(w) = waiting.get_mut(u) {
+                *w -= 1;
+                if *w == 0 {
+                    ready.push(u);
+                }
+            }
         }
     }
     done
