@@ -186,8 +186,8 @@ impl Layer<'_> {
         );
     }
 
-    /// Warns when a quantity that must be positive is not, at the file's
-    /// parameter values.
+    /// Records an error when a quantity that must be positive is not, at the
+    /// file's parameter values (and goes on).
     fn positive(&mut self, s: &Sym, what: &str, span: Range<usize>) {
         if let Some(v) = self.value(s)
             && v.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
