@@ -195,6 +195,63 @@ pub fn projector<const N: usize>(
     }
 }
 
+/// The v of least ½ vᵀHv with rₖ·v = dₖ for the `conditions` (rₖ, dₖ), for
+/// H symmetric positive definite.
+///
+/// The rows are taken in order; one that depends on earlier ones (its part
+/// off their span, in the metric of H, below `1e-12` of its size) adds no
+/// condition, so the independent rows hold exactly and the caller checks
+/// the others (they hold too when the conditions are consistent). With
+/// H = L Lᵀ and w = Lᵀ v the conditions read (L⁻¹rₖ)·w = dₖ and the least
+/// |w| lies in the span of the L⁻¹rₖ: Gram–Schmidt builds an orthonormal
+/// basis of it and, row by row, w's component along each new vector.
+pub fn least_solution<const N: usize>(
+    h: &[[f64; N]; N],
+    conditions: impl IntoIterator<Item = ([f64; N], f64)>,
+) -> Result<[f64; N], ProjectorError> {
+    let finite = |x: &[f64]| x.iter().all(|v| v.is_finite());
+    if !h.iter().all(|row| finite(row)) {
+        return Err(ProjectorError::NonFinite);
+    }
+    let chol = Cholesky::new(h, N).ok_or(ProjectorError::MassMatrixNotPositiveDefinite)?;
+    let mut basis = [[0.0; N]; N];
+    let mut along = [0.0; N];
+    let mut rank = 0;
+    for (row, dk) in conditions {
+        if !finite(&row) || !dk.is_finite() {
+            return Err(ProjectorError::NonFinite);
+        }
+        let mut c = chol.solve_lower(&row);
+        let size = libm::sqrt(dot(&c, &c));
+        let mut known = 0.0;
+        for (e, a) in basis[..rank].iter().zip(&along[..rank]) {
+            let k = dot(e, &c);
+            known += k * a;
+            for (ci, ei) in c.iter_mut().zip(e) {
+                *ci -= k * ei;
+            }
+        }
+        let rest = libm::sqrt(dot(&c, &c));
+        if size > 0.0 && rest > 1e-12 * size && rank < N {
+            basis[rank] = c.map(|x| x / rest);
+            along[rank] = (dk - known) / rest;
+            rank += 1;
+        }
+    }
+    let mut w = [0.0; N];
+    for (e, a) in basis[..rank].iter().zip(&along[..rank]) {
+        for (wi, ei) in w.iter_mut().zip(e) {
+            *wi += a * ei;
+        }
+    }
+    let v = chol.solve_upper(&w);
+    if finite(&v) {
+        Ok(v)
+    } else {
+        Err(ProjectorError::DependentRows)
+    }
+}
+
 /// The collision map v⁺ = (I − 2P) v.
 pub fn reflect<const N: usize>(p: &[[f64; N]; N], v: &[f64; N]) -> [f64; N] {
     let pv = mat_vec(p, v);
@@ -256,5 +313,52 @@ pub fn correction<const N: usize>(
         Ok(delta)
     } else {
         Err(ProjectorError::DependentRows)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const H: [[f64; 3]; 3] = [[4.0, 1.0, 0.5], [1.0, 3.0, 0.2], [0.5, 0.2, 2.0]];
+
+    /// The least ½ vᵀHv with R v = d satisfies the rows, and H v is
+    /// orthogonal to ker R (the optimality condition H v = Rᵀμ).
+    #[test]
+    fn least_solution_meets_the_rows_and_is_least() {
+        let rows = [[1.0, 2.0, -1.0]];
+        let v = least_solution(&H, [(rows[0], 3.0)]).unwrap();
+        assert!((dot(&rows[0], &v) - 3.0).abs() < 1e-14);
+        // Two directions spanning ker R.
+        for z in [[2.0, -1.0, 0.0], [1.0, 0.0, 1.0]] {
+            assert!(dot(&rows[0], &z).abs() < 1e-15);
+            assert!(dot(&mat_vec(&H, &v), &z).abs() < 1e-14, "{v:?}");
+        }
+        // By hand: μ = d / (R H⁻¹ Rᵀ), v = μ H⁻¹ Rᵀ, the same solve.
+        let chol = Cholesky::new(&H, 3).unwrap();
+        let y = chol.solve(&rows[0]);
+        let mu = 3.0 / dot(&rows[0], &y);
+        for i in 0..3 {
+            assert!((v[i] - mu * y[i]).abs() < 1e-14);
+        }
+    }
+
+    /// A row that repeats a combination of earlier ones adds no condition:
+    /// consistent, the answer is that of the independent rows; conflicting,
+    /// the independent rows hold and the repeated one does not.
+    #[test]
+    fn dependent_rows_add_no_condition() {
+        let rows = [[1.0, 0.0, 1.0], [0.0, 1.0, 0.0], [2.0, 1.0, 2.0]];
+        let with = |d: [f64; 3], k: usize| least_solution(&H, rows.into_iter().zip(d).take(k));
+        let alone = with([1.0, 2.0, 0.0], 2).unwrap();
+        let consistent = with([1.0, 2.0, 4.0], 3).unwrap();
+        assert_eq!(alone, consistent);
+        let conflicting = with([1.0, 2.0, 5.0], 3).unwrap();
+        assert!((dot(&rows[0], &conflicting) - 1.0).abs() < 1e-14);
+        assert!((dot(&rows[2], &conflicting) - 4.0).abs() < 1e-14);
+        assert_eq!(
+            least_solution(&[[0.0; 3]; 3], rows.into_iter().zip([1.0, 2.0, 4.0])),
+            Err(ProjectorError::MassMatrixNotPositiveDefinite)
+        );
     }
 }

@@ -163,6 +163,12 @@ pub trait Dynamics<const N: usize>: Model<N, N> {
     fn initial_velocities(&self) -> [f64; N] {
         [0.0; N]
     }
+    /// Which of [`Dynamics::initial_velocities`] the model file gives; the
+    /// others follow from the constraints at the start
+    /// ([`crate::simulate::starting_velocity`]). All by default.
+    fn initial_velocities_given(&self) -> [bool; N] {
+        [true; N]
+    }
 
     /// Potential energy V(q).
     fn potential(&self, q: &[f64; N]) -> f64;

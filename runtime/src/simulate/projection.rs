@@ -3,7 +3,7 @@
 
 use super::integrator::Engine;
 use super::phase::{Phase, norm};
-use super::thresholds::{HOLONOMIC_DONE_ULPS, HOLONOMIC_FAILED, HOLONOMIC_STEPS};
+use super::thresholds::{ADMISSIBLE, HOLONOMIC_DONE_ULPS, HOLONOMIC_FAILED, HOLONOMIC_STEPS};
 use super::{Residual, SimError, Simulator};
 use crate::linalg::{self, ProjectorError};
 use crate::{Dynamics, Surfaces};
@@ -135,4 +135,63 @@ pub fn tangent_direction<M: Dynamics<N>, const N: usize>(
     let r: [f64; N] = core::array::from_fn(|k| av.as_slice().get(k).map_or(0.0, |x| x + moved[k]));
     let d = linalg::correction(&g, a.as_slice(), &r[..a.len()])?;
     Ok((dq, core::array::from_fn(|i| dv[i] - d[i])))
+}
+
+/// How [`starting_velocity`] found the start's velocity.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StartRule {
+    /// The given entries are kept and the others follow from the
+    /// constraints.
+    Completed,
+    /// The given entries cannot be completed to an admissible velocity: the
+    /// given velocity (zero elsewhere) projected onto ker A, as [`admissible`].
+    Projected,
+}
+
+/// The starting velocity at q from the entries of `v` marked in `given`
+/// (the others of `v` are ignored), as a user states a start: the given
+/// entries are kept and the others follow from A(q) q̇ = 0. Where the
+/// constraints leave a choice, the others have the least kinetic energy of
+/// their own, ½ uᵀ G_uu u over the entries u not given; without
+/// constraints on them they are zero. When no choice of the others makes
+/// the velocity admissible, the given velocity with zeros elsewhere is
+/// projected G-orthogonally onto ker A ([`StartRule::Projected`]).
+pub fn starting_velocity<M: Dynamics<N>, const N: usize>(
+    m: &M,
+    q: &[f64; N],
+    v: &[f64; N],
+    given: &[bool; N],
+) -> Result<([f64; N], StartRule), ProjectorError> {
+    let v: [f64; N] = core::array::from_fn(|i| if given[i] { v[i] } else { 0.0 });
+    let a = m.constraints(q);
+    if a.is_empty() {
+        return Ok((v, StartRule::Completed));
+    }
+    // The metric: G on the entries not given, the identity on the given
+    // ones (fixed by their rows, so it only has to be positive there).
+    let g = m.mass_matrix(q);
+    let h: [[f64; N]; N] = core::array::from_fn(|i| {
+        core::array::from_fn(|j| match (given[i], given[j]) {
+            (false, false) => g[i][j],
+            (true, true) if i == j => 1.0,
+            _ => 0.0,
+        })
+    });
+    let unit = |i: usize| core::array::from_fn(|j| if i == j { 1.0 } else { 0.0 });
+    let conditions = a.as_slice().iter().map(|row| (*row, 0.0));
+    let fixed = (0..N).filter(|i| given[*i]).map(|i| (unit(i), v[i]));
+    let completed = linalg::least_solution(&h, conditions.chain(fixed))?;
+    let scale = 1.0 + norm(q) + norm(&v);
+    let off = a.apply(&completed).max_abs();
+    let moved = (0..N)
+        .filter(|i| given[*i])
+        .map(|i| (completed[i] - v[i]).abs())
+        .fold(0.0, f64::max);
+    if off <= ADMISSIBLE * scale && moved <= ADMISSIBLE * scale {
+        // The given entries exactly as given (the solve rounds them).
+        let kept = core::array::from_fn(|i| if given[i] { v[i] } else { completed[i] });
+        Ok((kept, StartRule::Completed))
+    } else {
+        Ok((admissible(m, q, &v)?, StartRule::Projected))
+    }
 }
