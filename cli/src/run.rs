@@ -10,7 +10,8 @@ use dalembert::for_each_model;
 use dalembert::models::*;
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
-    DormandPrince, Integrator, Residual, Rk4, Settings, State, Taylor, admissible, residual,
+    DormandPrince, Integrator, Residual, Rk4, Settings, StartRule, State, Taylor, residual,
+    starting_velocity,
 };
 use dalembert::runtime::taylor::MAX_ORDER;
 use dalembert_codegen::Derivation;
@@ -261,8 +262,9 @@ pub fn checked_run(args: &RunArgs, flag: &str, span: f64) -> Result<(), String> 
 /// The model with `--set` applied and the starting state: the file's
 /// `[initial]` at the parameters in use (parameters are set first, so that
 /// an initial value such as `z = "r"` follows `--set r=1`), then the
-/// coordinates and velocities `--set` names; q on h(q) = 0, q̇ projected
-/// onto ker A.
+/// coordinates and velocities `--set` names; q on h(q) = 0, and the
+/// velocities neither gives following from A q̇ = 0
+/// ([`starting_velocity`]).
 pub fn start<M: Surfaces<N>, const N: usize>(
     set: &[(String, f64)],
     mut model: M,
@@ -292,11 +294,13 @@ pub fn start<M: Surfaces<N>, const N: usize>(
     }
     let mut q = model.initial_coordinates();
     let mut v = model.initial_velocities();
+    let mut given = model.initial_velocities_given();
     for (name, value) in set {
         if let Some(i) = model.coordinate_names().iter().position(|c| c == name) {
             q[i] = *value;
         } else if let Some(i) = model.velocity_names().iter().position(|c| c == name) {
             v[i] = *value;
+            given[i] = true;
         }
     }
     let position = residual(&model, &q, &v).position;
@@ -305,13 +309,29 @@ pub fn start<M: Surfaces<N>, const N: usize>(
             "the initial coordinates violate the holonomic constraints (|h(q)| = {position:e}): set them on the constraint manifold"
         ));
     }
-    let projected = admissible(&model, &q, &v).map_err(|e| {
-        format!("the initial velocity cannot be projected onto the constraints (A q̇ = 0): {e}")
+    let (projected, rule) = starting_velocity(&model, &q, &v, &given).map_err(|e| {
+        format!("the initial velocity cannot be put on the constraints (A q̇ = 0): {e}")
     })?;
-    if projected.iter().zip(&v).any(|(a, b)| (a - b).abs() > 1e-12) {
-        eprintln!(
-            "note: the initial velocity {v:?} is not admissible (A q̇ ≠ 0); using its G-orthogonal projection onto ker A, {projected:?}"
-        );
+    let names = model.velocity_names();
+    match rule {
+        StartRule::Completed => {
+            let followed: Vec<String> = (0..N)
+                .filter(|i| !given[*i] && projected[*i] != 0.0)
+                .map(|i| format!("{} = {:e}", names[i], projected[i]))
+                .collect();
+            if !followed.is_empty() {
+                eprintln!(
+                    "note: the velocities the start does not give follow from the constraints: {}",
+                    followed.join(", ")
+                );
+            }
+        }
+        StartRule::Projected => {
+            let stated: Vec<f64> = (0..N).map(|i| if given[i] { v[i] } else { 0.0 }).collect();
+            eprintln!(
+                "note: the initial velocity {stated:?} is not admissible (A q̇ ≠ 0), and no choice of the velocities it does not give makes it so; using its G-orthogonal projection onto ker A, {projected:?}"
+            );
+        }
     }
     // The residuals of the state the run starts from (its first row), not
     // of the velocity given before the projection.

@@ -237,7 +237,7 @@ pub const TABLE: &[Spec] = &[
         name: "initial_state",
         inputs: Inputs::Parameters,
         shape: Shape::State,
-        doc: "The starting state of the model file's `[initial]` (zero where it is silent), at these parameters: (q, q̇).",
+        doc: "The starting state of the model file's `[initial]` (zero where it is silent), at these parameters: (q, q̇). The velocities it is silent on follow from the constraints (`VELOCITIES_GIVEN`, `dalembert_runtime::simulate::starting_velocity`).",
         capability: Capability::Dynamics,
         method: None,
     },

@@ -2,7 +2,7 @@
 
 #![allow(dead_code)] // each test binary uses some of these
 
-use dalembert::runtime::simulate::{DormandPrince, Integrator, Settings, State};
+use dalembert::runtime::simulate::{DormandPrince, Integrator, Settings, State, starting_velocity};
 use dalembert::runtime::{Dynamics, FromParams, Model, Rows};
 use nalgebra::DMatrix;
 use proptest::test_runner::{Config, TestCaseError, TestRunner};
@@ -84,13 +84,14 @@ pub fn toml_files(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
     files
 }
 
-/// The model file's initial state of `m`, at t = 0.
+/// The model file's initial state of `m`, at t = 0: the velocities the
+/// file leaves out follow from the constraints, as `simulate` starts.
 pub fn initial<M: Dynamics<N>, const N: usize>(m: &M) -> State<N> {
-    State {
-        t: 0.0,
-        q: m.initial_coordinates(),
-        v: m.initial_velocities(),
-    }
+    let q = m.initial_coordinates();
+    let given = m.initial_velocities_given();
+    let (v, _) = starting_velocity(m, &q, &m.initial_velocities(), &given)
+        .expect("the file's start can be put on the constraints");
+    State { t: 0.0, q, v }
 }
 
 /// Dormand–Prince at `rtol`, with atol a hundredth of it.

@@ -26,6 +26,7 @@ pub(super) fn inherent_impl(d: &Ctx) -> TokenStream {
     let nn = Literal::usize_unsuffixed(n);
     let init_q = d.model.initial[..q].iter().map(|x| lit(d, *x));
     let init_v = d.model.initial[q..].iter().map(|x| lit(d, *x));
+    let given = d.model.velocities_given();
     let real = real(d);
     let name = &d.model.name;
     let coords = &d.model.coordinates;
@@ -58,10 +59,14 @@ pub(super) fn inherent_impl(d: &Ctx) -> TokenStream {
             /// file's parameter values; `initial_state` follows the parameters in use.
             #[allow(clippy::approx_constant)]
             pub const INITIAL_COORDINATES: [#real; #qn] = [#(#init_q),*];
-            /// The model file's initial velocities (`[initial]`, zero where silent) at the
-            /// file's parameter values; `initial_state` follows the parameters in use.
+            /// The velocities the model file's `[initial]` gives (zero where silent, see
+            /// `VELOCITIES_GIVEN`) at the file's parameter values; `initial_state` follows the
+            /// parameters in use.
             #[allow(clippy::approx_constant)]
             pub const INITIAL_VELOCITIES: [#real; #nn] = [#(#init_v),*];
+            /// Which initial velocities the model file gives; the others follow from the
+            /// constraints at the start (`dalembert_runtime::simulate::starting_velocity`).
+            pub const VELOCITIES_GIVEN: [bool; #nn] = [#(#given),*];
             /// The model with the given parameters.
             pub fn new(params: Params) -> Self {
                 Self { params, pre: Self::precompute(&params) }

@@ -35,6 +35,11 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
             .collect::<Vec<_>>()
     };
     let (model, walls) = (methods(Capability::Model), methods(Capability::Walls));
+    // A model without walls has an empty `Wall`: every per-wall method is
+    // `match wall {}`, which never reads its other arguments.
+    let no_walls = variants
+        .is_empty()
+        .then(|| quote! { #[allow(unused_variables, unreachable_code)] });
     let model_impl = quote! {
         impl ::dalembert_runtime::Model<#ql, #nl> for #ty {
             fn name(&self) -> &str { Self::NAME }
@@ -57,6 +62,7 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
             fn with_params(params: Params) -> Self { Self::new(params) }
             fn params(&self) -> &Params { &self.params }
         }
+        #no_walls
         impl ::dalembert_runtime::Walls<#ql, #nl> for #ty {
             type Wall = Wall;
             fn walls(&self) -> &[Wall] { Self::WALLS }
@@ -128,9 +134,11 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
         impl ::dalembert_runtime::Dynamics<#nl> for #ty {
             fn initial_coordinates(&self) -> [f64; #ql] { self.initial_state().0 }
             fn initial_velocities(&self) -> [f64; #nl] { self.initial_state().1 }
+            fn initial_velocities_given(&self) -> [bool; #nl] { Self::VELOCITIES_GIVEN }
             #( #dynamics )*
             #motion_series
         }
+        #no_walls
         impl ::dalembert_runtime::Surfaces<#nl> for #ty {
             #( #surfaces )*
             #surface_series

@@ -113,6 +113,8 @@ pub struct Interpreted<const N: usize> {
     parameters: &'static [&'static str],
     values: Vec<f64>,
     initial_state: Compiled,
+    /// Which initial velocities the file gives.
+    given: [bool; N],
     mass_matrix: Compiled,
     kinetic_energy: Compiled,
     potential: Compiled,
@@ -260,6 +262,7 @@ impl<const N: usize> Interpreted<N> {
             velocities: leak_names(m.velocities.iter().cloned()),
             parameters: leak_names(m.params.iter().map(|p| p.name.clone())),
             initial_state: model_fn(Quantity::InitialState)?,
+            given: core::array::from_fn(|i| m.velocities_given().get(i).copied().unwrap_or(true)),
             mass_matrix: model_fn(Quantity::MassMatrix)?,
             kinetic_energy: model_fn(Quantity::KineticEnergy)?,
             potential: model_fn(Quantity::Potential)?,
@@ -465,6 +468,9 @@ impl<const N: usize> Dynamics<N> for Interpreted<N> {
     }
     fn initial_velocities(&self) -> [f64; N] {
         self.initial_state().1
+    }
+    fn initial_velocities_given(&self) -> [bool; N] {
+        self.given
     }
     fn potential(&self, q: &[f64; N]) -> f64 {
         self.scalar(&self.potential, q, &[])

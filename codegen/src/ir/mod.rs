@@ -248,6 +248,18 @@ impl Model {
     pub fn type_name(&self) -> String {
         camel(&self.name)
     }
+
+    /// Which velocities the file's `[initial]` gives; the others follow
+    /// from the constraints at the start (the runtime's
+    /// `simulate::starting_velocity`).
+    pub fn velocities_given(&self) -> Vec<bool> {
+        let q = self.coordinates.len();
+        self.initial_state
+            .iter()
+            .skip(q)
+            .map(Option::is_some)
+            .collect()
+    }
 }
 
 /// CamelCase of a snake_case name.

@@ -105,9 +105,13 @@ impl Validator<'_> {
 
         let walls = self.walls(kind, &file.wall);
         let initial = self.initial(&coordinates, &velocities, &file.initial);
-        if file.wall.is_empty() {
+        // A model with coordinates may have no wall (motion only); one
+        // without describes a collision instant and needs one.
+        if file.wall.is_empty() && kind == Kind::Instantaneous {
             self.cx.error(
-                ErrorKind::Structure("the model has no wall: declare at least one [[wall]]".into()),
+                ErrorKind::Structure(
+                    "a model without coordinates describes a collision instant: declare at least one [[wall]]".into(),
+                ),
                 Some(dyn_span),
             );
         }

@@ -94,10 +94,14 @@ impl BallFloor {
     /// file's parameter values; `initial_state` follows the parameters in use.
     #[allow(clippy::approx_constant)]
     pub const INITIAL_COORDINATES: [f32; 0] = [];
-    /// The model file's initial velocities (`[initial]`, zero where silent) at the
-    /// file's parameter values; `initial_state` follows the parameters in use.
+    /// The velocities the model file's `[initial]` gives (zero where silent, see
+    /// `VELOCITIES_GIVEN`) at the file's parameter values; `initial_state` follows the
+    /// parameters in use.
     #[allow(clippy::approx_constant)]
     pub const INITIAL_VELOCITIES: [f32; 6] = [0f32, 0f32, 0f32, 0f32, 0f32, 0f32];
+    /// Which initial velocities the model file gives; the others follow from the
+    /// constraints at the start (`dalembert_runtime::simulate::starting_velocity`).
+    pub const VELOCITIES_GIVEN: [bool; 6] = [false, false, false, false, false, false];
     /// The model with the given parameters.
     pub fn new(params: Params) -> Self {
         Self {

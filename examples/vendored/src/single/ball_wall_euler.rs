@@ -122,10 +122,14 @@ impl BallWallEuler {
     /// file's parameter values; `initial_state` follows the parameters in use.
     #[allow(clippy::approx_constant)]
     pub const INITIAL_COORDINATES: [f32; 5] = [1.5f32, 0f32, 0f32, 1.5707964f32, 0f32];
-    /// The model file's initial velocities (`[initial]`, zero where silent) at the
-    /// file's parameter values; `initial_state` follows the parameters in use.
+    /// The velocities the model file's `[initial]` gives (zero where silent, see
+    /// `VELOCITIES_GIVEN`) at the file's parameter values; `initial_state` follows the
+    /// parameters in use.
     #[allow(clippy::approx_constant)]
     pub const INITIAL_VELOCITIES: [f32; 5] = [-0.5f32, 0f32, 2f32, 0f32, 1f32];
+    /// Which initial velocities the model file gives; the others follow from the
+    /// constraints at the start (`dalembert_runtime::simulate::starting_velocity`).
+    pub const VELOCITIES_GIVEN: [bool; 5] = [true, false, true, false, true];
     /// The model with the given parameters.
     pub fn new(params: Params) -> Self {
         Self {
@@ -697,7 +701,7 @@ impl BallWallEuler {
         let o9: f32 = t73;
         ([o0, o1, o2, o3, o4], [o5, o6, o7, o8, o9])
     }
-    /// The starting state of the model file's `[initial]` (zero where it is silent), at these parameters: (q, q̇).
+    /// The starting state of the model file's `[initial]` (zero where it is silent), at these parameters: (q, q̇). The velocities it is silent on follow from the constraints (`VELOCITIES_GIVEN`, `dalembert_runtime::simulate::starting_velocity`).
     #[inline]
     #[allow(unused_variables, clippy::approx_constant)]
     pub fn initial_state(&self) -> ([f32; 5], [f32; 5]) {
