@@ -12,7 +12,7 @@
 //! are computed here from the Euler angles by composing rotations, not
 //! from the model's expressions.
 
-use dalembert::models::ChaplyginBall;
+use dalembert::models::{BallWallEuler, ChaplyginBall};
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
     Integrator, Rk4, Settings, Simulator, StartRule, State, Taylor, starting_velocity,
@@ -113,6 +113,31 @@ fn the_start_follows_from_the_angular_rates() {
     let (v, rule) = starting_velocity(&ball, &q, &wrong, &all).unwrap();
     assert_eq!(rule, StartRule::Projected);
     assert!(norm(&slip(&ball, &q, &v)) < 1e-14);
+}
+
+/// Where the constraints leave a choice, the velocities not given take the
+/// least kinetic energy: the homogeneous rolling ball (`ball_wall_euler`,
+/// J scalar) given only ẋ must roll straight without spin, ω = (0, ẋ/r, 0)
+/// and ẏ = 0, at a tilt where the Euler rates of that motion are all
+/// non-zero (φ̇ = −ψ̇ cos θ cancels the spin about the vertical).
+#[test]
+fn a_start_with_a_choice_adds_nothing_to_what_the_constraints_force() {
+    let ball = BallWallEuler::default();
+    let r = ball.params().r;
+    let q = [1.0, 0.0, 0.3, 1.0, 0.2];
+    let mut v = [0.0; 5];
+    v[0] = 0.7;
+    let given = [true, false, false, false, false];
+    let (v, rule) = starting_velocity(&ball, &q, &v, &given).unwrap();
+    assert_eq!(rule, StartRule::Completed);
+    let w = omega(&q, &v);
+    let expected = [0.0, 0.7 / r, 0.0];
+    for i in 0..3 {
+        assert!((w[i] - expected[i]).abs() < 1e-13, "ω = {w:?}, v = {v:?}");
+    }
+    assert_eq!(v[0], 0.7);
+    assert!(v[1].abs() < 1e-14, "{v:?}");
+    assert!(v[2].abs() > 0.1 && v[4].abs() > 0.1, "{v:?}");
 }
 
 /// Along 20 s of rolling, energy and K stay at their starting values with

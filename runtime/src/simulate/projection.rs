@@ -152,8 +152,10 @@ pub enum StartRule {
 /// (the others of `v` are ignored), as a user states a start: the given
 /// entries are kept and the others follow from A(q) q̇ = 0. Where the
 /// constraints leave a choice, the others have the least kinetic energy of
-/// their own, ½ uᵀ G_uu u over the entries u not given; without
-/// constraints on them they are zero. When no choice of the others makes
+/// their own, ½ uᵀ G_uu u over the entries u not given: nothing is added to
+/// what the constraints force (a ball started by its centre's velocity
+/// rolls without spin), and they are all zero when the given entries are
+/// admissible by themselves. When no choice of the others makes
 /// the velocity admissible, the given velocity with zeros elsewhere is
 /// projected G-orthogonally onto ker A ([`StartRule::Projected`]).
 pub fn starting_velocity<M: Dynamics<N>, const N: usize>(
