@@ -50,71 +50,109 @@ fn bodies_give_the_hand_written_models() {
         "pendulum_wall",
         "superball",
     ] {
-        let b = derived("tests/bodies", name);
-        let h = derived("models", name);
-        assert_eq!(b.model.coordinates, h.model.coordinates, "{name}");
-        assert_eq!(b.model.velocities, h.model.velocities, "{name}");
-        for (i, (rb, rh)) in b.mass_matrix.iter().zip(&h.mass_matrix).enumerate() {
-            assert_same(&format!("{name}: G row {i}"), rb, rh);
-        }
-        assert_eq!(
-            b.constraint_rows.len(),
-            h.constraint_rows.len(),
-            "{name}: A"
+        same_model(
+            name,
+            &derived("tests/bodies", name),
+            &derived("models", name),
         );
-        for (i, (rb, rh)) in b.constraint_rows.iter().zip(&h.constraint_rows).enumerate() {
-            assert_same(&format!("{name}: A row {i}"), rb, rh);
-        }
-        assert_same(&format!("{name}: h(q)"), &b.holonomic, &h.holonomic);
-        match (&b.accelerations, &h.accelerations) {
-            (Some(qb), Some(qh)) => assert_same(&format!("{name}: q''"), qb, qh),
-            (None, None) => {}
-            _ => panic!("{name}: q'' in closed form for one and not the other"),
-        }
-        assert_eq!(b.walls.len(), h.walls.len(), "{name}: walls");
-        for (wb, wh) in b.walls.iter().zip(&h.walls) {
-            let what = format!("{name}, wall {}", wh.name);
-            assert_eq!(wb.name, wh.name);
-            match (&wb.geometry, &wh.geometry) {
-                (Geometry::Surface(fb), Geometry::Surface(fh)) => {
-                    assert!(same(fb, fh).unwrap(), "{what}: f = {fb}, not {fh}")
-                }
-                _ => panic!("{what}: geometry"),
+    }
+}
+
+/// The tutorial's two puck files (docs/tutorial.md, step 1: as bodies,
+/// then by hand) derive the built-in puck.
+#[test]
+fn the_tutorial_files_give_the_puck() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join("docs/tutorial.md")).unwrap();
+    let blocks: Vec<String> = text
+        .split("```toml\n")
+        .skip(1)
+        .map(|b| {
+            let block = b.split("```").next().unwrap();
+            block
+                .lines()
+                .map(|l| l.strip_prefix("   ").unwrap_or(l))
+                .collect::<Vec<_>>()
+                .join("\n")
+        })
+        .collect();
+    let hand = derived("models", "puck");
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("tutorial-puck");
+    std::fs::create_dir_all(&dir).unwrap();
+    for (k, block) in blocks[..2].iter().enumerate() {
+        let path = dir.join(format!("puck_{k}.toml"));
+        std::fs::write(&path, block).unwrap();
+        let d = derive(&path).unwrap_or_else(|e| panic!("tutorial block {k}: {e}"));
+        same_model(&format!("tutorial block {k}"), &d, &hand);
+    }
+    assert!(blocks[0].contains("[[knife_edge]]"), "{}", blocks[0]);
+}
+
+/// `b` derives what `h` does: the same G, A, h(q), q̈, surfaces, P and
+/// collision maps (symbolic equality), and no more operations (5 %).
+fn same_model(name: &str, b: &Derivation, h: &Derivation) {
+    assert_eq!(b.model.coordinates, h.model.coordinates, "{name}");
+    assert_eq!(b.model.velocities, h.model.velocities, "{name}");
+    for (i, (rb, rh)) in b.mass_matrix.iter().zip(&h.mass_matrix).enumerate() {
+        assert_same(&format!("{name}: G row {i}"), rb, rh);
+    }
+    assert_eq!(
+        b.constraint_rows.len(),
+        h.constraint_rows.len(),
+        "{name}: A"
+    );
+    for (i, (rb, rh)) in b.constraint_rows.iter().zip(&h.constraint_rows).enumerate() {
+        assert_same(&format!("{name}: A row {i}"), rb, rh);
+    }
+    assert_same(&format!("{name}: h(q)"), &b.holonomic, &h.holonomic);
+    match (&b.accelerations, &h.accelerations) {
+        (Some(qb), Some(qh)) => assert_same(&format!("{name}: q''"), qb, qh),
+        (None, None) => {}
+        _ => panic!("{name}: q'' in closed form for one and not the other"),
+    }
+    assert_eq!(b.walls.len(), h.walls.len(), "{name}: walls");
+    for (wb, wh) in b.walls.iter().zip(&h.walls) {
+        let what = format!("{name}, wall {}", wh.name);
+        assert_eq!(wb.name, wh.name);
+        match (&wb.geometry, &wh.geometry) {
+            (Geometry::Surface(fb), Geometry::Surface(fh)) => {
+                assert!(same(fb, fh).unwrap(), "{what}: f = {fb}, not {fh}")
             }
-            match (&wb.projection, &wh.projection) {
-                (
-                    Projection::ClosedForm {
-                        projector: pb,
-                        collision: cb,
-                    },
-                    Projection::ClosedForm {
-                        projector: ph,
-                        collision: ch,
-                    },
-                ) => {
-                    for (i, (rb, rh)) in pb.iter().zip(ph).enumerate() {
-                        assert_same(&format!("{what}: P row {i}"), rb, rh);
-                    }
-                    assert_same(&format!("{what}: v+"), cb, ch);
-                }
-                (Projection::Structured, Projection::Structured) => {}
-                _ => panic!("{what}: P closed form for one and not the other"),
-            }
+            _ => panic!("{what}: geometry"),
         }
-        // The generated code costs what the hand-written model's does.
-        let (fb, fh) = (b.named_functions(), h.named_functions());
-        assert_eq!(
-            fb.iter().map(|(n, _)| n).collect::<Vec<_>>(),
-            fh.iter().map(|(n, _)| n).collect::<Vec<_>>(),
-            "{name}: functions"
+        match (&wb.projection, &wh.projection) {
+            (
+                Projection::ClosedForm {
+                    projector: pb,
+                    collision: cb,
+                },
+                Projection::ClosedForm {
+                    projector: ph,
+                    collision: ch,
+                },
+            ) => {
+                for (i, (rb, rh)) in pb.iter().zip(ph).enumerate() {
+                    assert_same(&format!("{what}: P row {i}"), rb, rh);
+                }
+                assert_same(&format!("{what}: v+"), cb, ch);
+            }
+            (Projection::Structured, Projection::Structured) => {}
+            _ => panic!("{what}: P closed form for one and not the other"),
+        }
+    }
+    // The generated code costs what the hand-written model's does.
+    let (fb, fh) = (b.named_functions(), h.named_functions());
+    assert_eq!(
+        fb.iter().map(|(n, _)| n).collect::<Vec<_>>(),
+        fh.iter().map(|(n, _)| n).collect::<Vec<_>>(),
+        "{name}: functions"
+    );
+    for ((n, b), (_, h)) in fb.iter().zip(&fh) {
+        let (ob, oh) = (b.program.op_count().total(), h.program.op_count().total());
+        assert!(
+            ob as f64 <= 1.05 * oh as f64,
+            "{name}: {n} takes {ob} operations from bodies, {oh} by hand"
         );
-        for ((n, b), (_, h)) in fb.iter().zip(&fh) {
-            let (ob, oh) = (b.program.op_count().total(), h.program.op_count().total());
-            assert!(
-                ob as f64 <= 1.05 * oh as f64,
-                "{name}: {n} takes {ob} operations from bodies, {oh} by hand"
-            );
-        }
     }
 }
 
