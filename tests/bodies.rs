@@ -164,6 +164,10 @@ fn mat(a: &M3, b: &M3) -> M3 {
     std::array::from_fn(|i| std::array::from_fn(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum()))
 }
 
+fn apply(a: &M3, v: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|i| (0..3).map(|k| a[i][k] * v[k]).sum())
+}
+
 fn transpose(a: &M3) -> M3 {
     std::array::from_fn(|i| std::array::from_fn(|j| a[j][i]))
 }
@@ -439,4 +443,119 @@ fn curved_walls_follow_the_contact_law() {
             }
         }
     }
+}
+
+// --- Rolling inside a bowl ----------------------------------------------------
+
+/// The unit vector from the bowl's centre to the ball's in
+/// `tests/bodies/rolling_in_bowl.toml`: (sin a, cos a sin b, −cos a cos b).
+fn bowl_normal(a: f64, b: f64) -> [f64; 3] {
+    [a.sin(), a.cos() * b.sin(), -a.cos() * b.cos()]
+}
+
+/// A homogeneous ball (m = 1, r = 1/5, J = 2/25) rolling inside a sphere of
+/// radius 1, against two classical answers. In the plane b = 0 the centre
+/// moves as a pendulum of length ρ(1 + J/(m r²)), ρ = R − r (T = ½(m +
+/// J/r²)ρ²ȧ², V = −m g ρ cos a): released at rest from a = 1/2 it first
+/// reaches the bottom after √(l/g) K(sin ¼). In three dimensions the spin
+/// about the normal, ω·n, is constant, as is the energy: d(ω·n)/dt =
+/// ω̇·n + ω·ṅ, where J ω̇ = r n × F (the contact force F acts at r n from
+/// the centre) has no part along n, and ṅ = (r/ρ) n × ω (rolling) is
+/// orthogonal to ω. Those two hold for a ball on the outside of a sphere
+/// too, so the contact point itself, at R n from the bowl's centre, is
+/// checked to be at rest along the run.
+#[test]
+fn a_ball_rolls_in_a_bowl_as_theory_says() {
+    let d = derived("tests/bodies", "rolling_in_bowl");
+    let m = Interpreted::<5>::new(&d).unwrap();
+    let (mass, r, j, rho, g) = (1.0, 0.2, 0.08, 0.8, 9.81);
+    let settings = common::dormand_prince(1e-13);
+
+    let a0 = 0.5;
+    let q = [a0, 0.0, 0.0, std::f64::consts::FRAC_PI_2, 0.0];
+    let start = State {
+        t: 0.0,
+        q,
+        v: [0.0; 5],
+    };
+    let mut sim = Simulator::new(&m, start, settings).unwrap();
+    let mut bracket = None;
+    sim.run(2.0, |step| {
+        let below = step.state.q[0] <= 0.0;
+        if below {
+            bracket = Some((step.t0, step.state.t));
+        }
+        !below
+    })
+    .unwrap();
+    let (mut lo, mut hi) = bracket.expect("the ball reaches the bottom");
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if sim.state_at(mid).unwrap().q[0] > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let expected = common::pendulum_time(rho * (1.0 + j / (mass * r * r)), g, a0, 0.0);
+    assert!(
+        (lo - expected).abs() < 1e-10 * expected,
+        "the bottom at t = {lo}, the pendulum's {expected}"
+    );
+
+    // Off the plane, with a spin: the velocities the start leaves out follow.
+    let q = [0.4, 0.0, 0.0, 1.2, 0.0];
+    let v = [0.0, 0.8, 2.0, 0.0, 0.0];
+    let given = [false, true, true, false, false];
+    let (v, _) = dalembert::runtime::simulate::starting_velocity(&m, &q, &v, &given).unwrap();
+    let spin = |q: &[f64; 5], v: &[f64; 5]| {
+        let w = apply(&zxz_rates_matrix([q[2], q[3], q[4]]), [v[2], v[3], v[4]]);
+        let n = bowl_normal(q[0], q[1]);
+        (0..3).map(|i| w[i] * n[i]).sum::<f64>()
+    };
+    // The material point touching the bowl, at R n from its centre: at rest.
+    let slip = |q: &[f64; 5], v: &[f64; 5]| {
+        let (a, b, da, db) = (q[0], q[1], v[0], v[1]);
+        let centre = [
+            rho * a.cos() * da,
+            rho * (-a.sin() * b.sin() * da + a.cos() * b.cos() * db),
+            rho * (a.sin() * b.cos() * da + a.cos() * b.sin() * db),
+        ];
+        let w = apply(&zxz_rates_matrix([q[2], q[3], q[4]]), [v[2], v[3], v[4]]);
+        let n = bowl_normal(a, b).map(|x| r * x);
+        let turn = [
+            w[1] * n[2] - w[2] * n[1],
+            w[2] * n[0] - w[0] * n[2],
+            w[0] * n[1] - w[1] * n[0],
+        ];
+        (0..3)
+            .map(|i| (centre[i] + turn[i]).abs())
+            .fold(0.0, f64::max)
+    };
+    let energy = |q: &[f64; 5], v: &[f64; 5]| m.kinetic_energy(q, v) + m.potential(q);
+    let (s0, e0) = (spin(&q, &v), energy(&q, &v));
+    assert!(s0.abs() > 0.5, "{s0}");
+    let mut sim = Simulator::new(&m, State { t: 0.0, q, v }, settings).unwrap();
+    let (mut worst_s, mut worst_e, mut widest) = (0.0f64, 0.0f64, 0.0f64);
+    let mut worst_slip = slip(&q, &v);
+    sim.run(10.0, |step| {
+        let (q, v) = (&step.state.q, &step.state.v);
+        worst_slip = worst_slip.max(slip(q, v));
+        worst_s = worst_s.max((spin(q, v) - s0).abs());
+        worst_e = worst_e.max((energy(q, v) - e0).abs());
+        widest = widest.max(q[1].abs());
+        true
+    })
+    .unwrap();
+    assert_eq!(sim.state().t, 10.0);
+    assert!(widest > 0.1, "the centre leaves the plane b = 0: {widest}");
+    assert!(
+        worst_slip < 1e-12,
+        "the contact point moves at {worst_slip:e}"
+    );
+    assert!(worst_s < 1e-10 * s0.abs(), "ω·n: {s0}, off by {worst_s:e}");
+    assert!(
+        worst_e < 1e-10 * e0.abs(),
+        "energy: {e0}, off by {worst_e:e}"
+    );
 }

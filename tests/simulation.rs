@@ -12,37 +12,11 @@ use dalembert::models::{BallBounce, BallWallEuler, Chain3, MassesOnLine, Pendulu
 #[path = "common/bounce.rs"]
 mod bounce;
 mod common;
-use common::{dormand_prince, initial};
+use common::{dormand_prince, initial, pendulum_time};
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{Integrator, Rk4, Settings, Simulator, State, admissible};
 
 // ------------------------------------------------------------ helpers
-
-/// Carlson's symmetric elliptic integral R_F(x, y, z) by duplication.
-fn carlson_rf(mut x: f64, mut y: f64, mut z: f64) -> f64 {
-    for _ in 0..60 {
-        let l = (x * y).sqrt() + (y * z).sqrt() + (z * x).sqrt();
-        x = (x + l) / 4.0;
-        y = (y + l) / 4.0;
-        z = (z + l) / 4.0;
-    }
-    1.0 / ((x + y + z) / 3.0).sqrt()
-}
-
-/// Incomplete elliptic integral of the first kind F(φ, k).
-fn elliptic_f(phi: f64, k: f64) -> f64 {
-    let (s, c) = phi.sin_cos();
-    s * carlson_rf(c * c, 1.0 - k * k * s * s, 1.0)
-}
-
-/// Time for a pendulum of length l released from rest at angle θ₀ (from
-/// the downward vertical) to swing through the bottom to angle θ on the
-/// other side: √(l/g) [K(k) + F(φ, k)], k = sin(θ₀/2), sin φ = sin(θ/2)/k.
-fn pendulum_time(l: f64, g: f64, theta0: f64, theta: f64) -> f64 {
-    let k = (theta0 / 2.0).sin();
-    let phi = ((theta / 2.0).sin() / k).asin();
-    (l / g).sqrt() * (elliptic_f(std::f64::consts::FRAC_PI_2, k) + elliptic_f(phi, k))
-}
 
 /// The bob of `PendulumWall` at rest at angle θ₀ on the left.
 fn bob_at_rest(p: &PendulumWall, theta0: f64) -> State<2> {

@@ -159,12 +159,15 @@ pub(super) struct RoundDecl {
     pub(super) radius: Spanned<Number>,
 }
 
-/// A ball rolling without slipping on a plane.
+/// A ball rolling without slipping on a plane, or inside a sphere or a
+/// cylinder (exactly one of the three).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RollingDecl {
     pub(super) body: Spanned<String>,
-    pub(super) plane: Spanned<PlaneDecl>,
+    pub(super) plane: Option<Spanned<PlaneDecl>>,
+    pub(super) sphere: Option<Spanned<RoundDecl>>,
+    pub(super) cylinder: Option<Spanned<RoundDecl>>,
 }
 
 /// A knife edge (skate) at the body's centre, its blade along a body-frame

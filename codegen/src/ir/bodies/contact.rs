@@ -2,6 +2,7 @@
 //! edge, and walls by shape (plane, sphere or cylinder from inside) and law
 //! (smooth, or rough: the contact point's no-slip rows).
 
+use std::collections::HashMap;
 use std::ops::Range;
 
 use toml::Spanned;
@@ -70,6 +71,43 @@ impl Layer<'_> {
         Some(k)
     }
 
+    /// A sphere's or a cylinder's centre, axis (a cylinder's) and radius,
+    /// from whichever of the two is given.
+    fn round(
+        &mut self,
+        sphere: &Option<Spanned<RoundDecl>>,
+        cylinder: &Option<Spanned<RoundDecl>>,
+    ) -> Option<(Vec3, Option<Vec3>, Sym)> {
+        let (decl, is_cylinder) = match (sphere, cylinder) {
+            (Some(s), _) => (s, false),
+            (_, Some(c)) => (c, true),
+            _ => return None,
+        };
+        let RoundDecl {
+            centre,
+            axis,
+            radius,
+        } = decl.get_ref();
+        let c = self.vector(centre)?;
+        let big = self.sym(radius)?;
+        let axis = match (axis, is_cylinder) {
+            (Some(a), true) => {
+                let a = self.vector(a)?;
+                self.unit_vector(&a, decl.span())?;
+                Some(a)
+            }
+            (None, false) => None,
+            _ => {
+                self.cx.error(
+                    structure("a cylinder has `axis`, a unit vector; a sphere has none"),
+                    Some(decl.span()),
+                );
+                return None;
+            }
+        };
+        Some((c, axis, big))
+    }
+
     /// Rows saying that the point at `offset` from the centre of `body` is
     /// at rest, except its component along `normal`: the components across
     /// the normal's largest axis `k` (with the normal's row, they span all
@@ -85,8 +123,31 @@ impl Layer<'_> {
 
     pub(super) fn rolling(&mut self, decl: &Spanned<RollingDecl>) {
         let r = decl.get_ref();
-        let Some((n, offset, k)) = self.plane(&r.plane) else {
+        let shapes = usize::from(r.plane.is_some())
+            + usize::from(r.sphere.is_some())
+            + usize::from(r.cylinder.is_some());
+        if shapes != 1 {
+            self.cx.error(
+                structure("a ball rolls on a `plane` or inside a `sphere` or a `cylinder`: give exactly one"),
+                Some(decl.span()),
+            );
             return;
+        }
+        let plane = match &r.plane {
+            Some(p) => {
+                let Some(plane) = self.plane(p) else { return };
+                Some(plane)
+            }
+            None => None,
+        };
+        let round = match plane {
+            Some(_) => None,
+            None => {
+                let Some(round) = self.round(&r.sphere, &r.cylinder) else {
+                    return;
+                };
+                Some(round)
+            }
         };
         let Some(body) = self.find(&r.body) else {
             return;
@@ -101,8 +162,42 @@ impl Layer<'_> {
             );
             return;
         };
-        let rows = Self::no_slip(&body, &scale(&mul([int(-1), radius.clone()]), &n), Some(k));
-        let height = sub(sub(dot(&n, &body.position), offset), radius);
+        let rows = match (plane, round) {
+            (Some((n, offset, k)), _) => {
+                let Some(rows) = self.on_plane(decl, &body, &radius, &n, &offset, k) else {
+                    return;
+                };
+                rows
+            }
+            (None, Some((c, axis, big))) => {
+                let Some(rows) = self.inside(decl, &body, &radius, &c, axis.as_ref(), &big) else {
+                    return;
+                };
+                rows
+            }
+            (None, None) => return,
+        };
+        for row in rows {
+            self.out
+                .constraints
+                .push(Spanned::new(decl.span(), row.to_string()));
+        }
+    }
+
+    /// A ball on a plane: the contact point's velocity across the normal's
+    /// largest axis; its height above the plane becomes a holonomic
+    /// constraint where it varies.
+    fn on_plane(
+        &mut self,
+        decl: &Spanned<RollingDecl>,
+        body: &Body,
+        radius: &Sym,
+        n: &Vec3,
+        offset: &Sym,
+        k: usize,
+    ) -> Option<Vec<Sym>> {
+        let rows = Self::no_slip(body, &scale(&mul([int(-1), radius.clone()]), n), Some(k));
+        let height = sub(sub(dot(n, &body.position), offset.clone()), radius.clone());
         let coordinates = &self.coordinates;
         if height.depends(&|x| coordinates.iter().any(|c| c == x)) {
             self.out
@@ -117,13 +212,89 @@ impl Layer<'_> {
                 )),
                 Some(decl.span()),
             );
-            return;
+            return None;
         }
-        for row in rows {
-            self.out
-                .constraints
-                .push(Spanned::new(decl.span(), row.to_string()));
+        Some(rows)
+    }
+
+    /// A ball inside a sphere or a cylinder of radius R: its centre keeps
+    /// the distance R − r from the centre (the axis), which the position
+    /// must say by its coordinates (two angles, say); the contact point is
+    /// at r d/(R − r) from the centre. The no-slip rows are the contact
+    /// point's velocity along two tangent directions, t = ∂C/∂qⱼ for the
+    /// first coordinate that moves the centre and d × t; with the normal
+    /// (along which that velocity is zero on the surface) they span all
+    /// three wherever t ≠ 0.
+    fn inside(
+        &mut self,
+        decl: &Spanned<RollingDecl>,
+        body: &Body,
+        radius: &Sym,
+        c: &Vec3,
+        axis: Option<&Vec3>,
+        big: &Sym,
+    ) -> Option<Vec<Sym>> {
+        let d = across(&body.position, c, axis);
+        let reach = sub(big.clone(), radius.clone());
+        let gap = sub(square(reach.clone()), dot(&d, &d));
+        if let Some(worst) = self.largest_over_coordinates(&gap)
+            && worst > 1e-9
+        {
+            self.cx.error(
+                structure(format!(
+                    "a ball rolling inside a sphere or cylinder of radius R keeps its centre at R − r from the centre (axis): write its position by coordinates that keep it there (two angles, say); here the squares of the two differ by up to {worst:.3} at sample coordinates"
+                )),
+                Some(decl.span()),
+            );
+            return None;
         }
+        let Some(t) = self
+            .coordinates
+            .clone()
+            .iter()
+            .map(|q| body.position.clone().map(|x| x.derivative(q)))
+            .find(|t| t.iter().any(|x| !x.is_zero()))
+        else {
+            self.cx.error(
+                structure("the ball's centre does not move: nothing rolls"),
+                Some(decl.span()),
+            );
+            return None;
+        };
+        let other = cross(&d, &t);
+        let offset = scale(&div(radius.clone(), reach), &d);
+        let slip = plus(&body.velocity, &cross(&body.omega, &offset));
+        Some(vec![dot(&slip, &t), dot(&slip, &other)])
+    }
+
+    /// The largest |e| at a few sample values of the coordinates (the
+    /// parameters at the file's values); `None` where e has no value.
+    fn largest_over_coordinates(&self, e: &Sym) -> Option<f64> {
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut worst = 0.0f64;
+        for _ in 0..8 {
+            let sample: HashMap<&str, f64> = self
+                .coordinates
+                .iter()
+                .map(|q| {
+                    seed ^= seed << 13;
+                    seed ^= seed >> 7;
+                    seed ^= seed << 17;
+                    (
+                        q.as_str(),
+                        -2.0 + 4.0 * (seed >> 11) as f64 / (1u64 << 53) as f64,
+                    )
+                })
+                .collect();
+            let v = e.value(&|n| {
+                sample
+                    .get(n)
+                    .copied()
+                    .or_else(|| self.values.get(n).copied())
+            })?;
+            worst = worst.max(v.abs());
+        }
+        Some(worst)
     }
 
     pub(super) fn knife_edge(&mut self, decl: &Spanned<KnifeEdgeDecl>) {
@@ -194,34 +365,8 @@ impl Layer<'_> {
             };
             Shape::Plane(n, offset, k)
         } else {
-            let (decl, cylinder): (&Spanned<RoundDecl>, bool) = match (&w.sphere, &w.cylinder) {
-                (Some(s), _) => (s, false),
-                (_, Some(c)) => (c, true),
-                _ => return,
-            };
-            let RoundDecl {
-                centre,
-                axis,
-                radius,
-            } = decl.get_ref();
-            let Some(c) = self.vector(centre) else { return };
-            let Some(big) = self.sym(radius) else { return };
-            let axis = match (axis, cylinder) {
-                (Some(a), true) => {
-                    let Some(a) = self.vector(a) else { return };
-                    if self.unit_vector(&a, decl.span()).is_none() {
-                        return;
-                    }
-                    Some(a)
-                }
-                (None, false) => None,
-                _ => {
-                    self.cx.error(
-                        structure("a cylinder has `axis`, a unit vector; a sphere has none"),
-                        Some(decl.span()),
-                    );
-                    return;
-                }
+            let Some((c, axis, big)) = self.round(&w.sphere, &w.cylinder) else {
+                return;
             };
             Shape::Round(c, axis, big)
         };
@@ -236,10 +381,7 @@ impl Layer<'_> {
                 Some(*k),
             ),
             Shape::Round(c, axis, big) => {
-                let mut d = minus(&body.position, c);
-                if let Some(a) = axis {
-                    d = minus(&d, &scale(&dot(&d, a), a));
-                }
+                let d = across(&body.position, c, axis.as_ref());
                 let reach = sub(big.clone(), r.clone());
                 let f = div(
                     sub(square(reach.clone()), dot(&d, &d)),
@@ -269,5 +411,15 @@ impl Layer<'_> {
             .into_iter()
             .map(|r| Spanned::new(span.clone(), r.to_string()))
             .collect();
+    }
+}
+
+/// The position `p` from a sphere's centre `c`, or from a cylinder's axis
+/// through `c` (its component along `axis` removed).
+fn across(p: &Vec3, c: &Vec3, axis: Option<&Vec3>) -> Vec3 {
+    let d = minus(p, c);
+    match axis {
+        Some(a) => minus(&d, &scale(&dot(&d, a), a)),
+        None => d,
     }
 }
