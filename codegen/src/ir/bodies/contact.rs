@@ -237,16 +237,24 @@ impl Layer<'_> {
         let d = across(&body.position, c, axis);
         let reach = sub(big.clone(), radius.clone());
         let gap = sub(square(reach.clone()), dot(&d, &d));
-        if let Some(worst) = self.largest_over_coordinates(&gap)
-            && worst > 1e-9
-        {
-            self.cx.error(
-                structure(format!(
-                    "a ball rolling inside a sphere or cylinder of radius R keeps its centre at R − r from the centre (axis): write its position by coordinates that keep it there (two angles, say); here the squares of the two differ by up to {worst:.3} at sample coordinates"
-                )),
-                Some(decl.span()),
-            );
-            return None;
+        let scale_of = self.value(&square(reach.clone())).unwrap_or(1.0);
+        match self.largest_over_coordinates(&gap) {
+            Some(worst) if worst <= 1e-9 * (1.0 + scale_of) => {}
+            found => {
+                let why = match found {
+                    Some(worst) => format!(
+                        "here the squares of the two differ by up to {worst:.3} at sample coordinates"
+                    ),
+                    None => "it has no value at enough sample coordinates to check".to_string(),
+                };
+                self.cx.error(
+                    structure(format!(
+                        "a ball rolling inside a sphere or cylinder of radius R keeps its centre at R − r from the centre (axis): write its position by coordinates that keep it there (two angles, say); {why}"
+                    )),
+                    Some(decl.span()),
+                );
+                return None;
+            }
         }
         let Some(t) = self
             .coordinates
@@ -267,12 +275,17 @@ impl Layer<'_> {
         Some(vec![dot(&slip, &t), dot(&slip, &other)])
     }
 
-    /// The largest |e| at a few sample values of the coordinates (the
-    /// parameters at the file's values); `None` where e has no value.
+    /// The largest |e| at sample values of the coordinates (the parameters
+    /// at the file's values), four in each of [−s, s] for s = 2, 1, 1/2, 1/4
+    /// (so that a position defined only near zero, through a square root,
+    /// is sampled too), over the samples where e has a finite value; `None`
+    /// when fewer than 4 of the 16 have one.
     fn largest_over_coordinates(&self, e: &Sym) -> Option<f64> {
         let mut seed = 0x2545_f491_4f6c_dd1du64;
         let mut worst = 0.0f64;
-        for _ in 0..8 {
+        let mut defined = 0;
+        for k in 0..16 {
+            let size = 2.0 / f64::from(1u32 << (k / 4));
             let sample: HashMap<&str, f64> = self
                 .coordinates
                 .iter()
@@ -282,7 +295,7 @@ impl Layer<'_> {
                     seed ^= seed << 17;
                     (
                         q.as_str(),
-                        -2.0 + 4.0 * (seed >> 11) as f64 / (1u64 << 53) as f64,
+                        size * (2.0 * (seed >> 11) as f64 / (1u64 << 53) as f64 - 1.0),
                     )
                 })
                 .collect();
@@ -291,10 +304,13 @@ impl Layer<'_> {
                     .get(n)
                     .copied()
                     .or_else(|| self.values.get(n).copied())
-            })?;
-            worst = worst.max(v.abs());
+            });
+            if let Some(v) = v.filter(|v| v.is_finite()) {
+                worst = worst.max(v.abs());
+                defined += 1;
+            }
         }
-        Some(worst)
+        (defined >= 4).then_some(worst)
     }
 
     pub(super) fn knife_edge(&mut self, decl: &Spanned<KnifeEdgeDecl>) {
