@@ -160,12 +160,7 @@ pub fn projector<const N: usize>(
     for row in b_rows {
         let mut c = chol.solve_lower(row);
         let size = libm::sqrt(dot(&c, &c));
-        for e in &basis[..rank] {
-            let k = dot(e, &c);
-            for (ci, ei) in c.iter_mut().zip(e) {
-                *ci -= k * ei;
-            }
-        }
+        off_span(&basis[..rank], &mut c);
         let rest = libm::sqrt(dot(&c, &c));
         if size > 0.0 && rest > 1e-12 * size && rank < N {
             basis[rank] = c.map(|x| x / rest);
@@ -223,14 +218,8 @@ pub fn least_solution<const N: usize>(
         }
         let mut c = chol.solve_lower(&row);
         let size = libm::sqrt(dot(&c, &c));
-        let mut known = 0.0;
-        for (e, a) in basis[..rank].iter().zip(&along[..rank]) {
-            let k = dot(e, &c);
-            known += k * a;
-            for (ci, ei) in c.iter_mut().zip(e) {
-                *ci -= k * ei;
-            }
-        }
+        let parts = off_span(&basis[..rank], &mut c);
+        let known: f64 = parts.iter().zip(&along[..rank]).map(|(k, a)| k * a).sum();
         let rest = libm::sqrt(dot(&c, &c));
         if size > 0.0 && rest > 1e-12 * size && rank < N {
             basis[rank] = c.map(|x| x / rest);
@@ -250,6 +239,19 @@ pub fn least_solution<const N: usize>(
     } else {
         Err(ProjectorError::DependentRows)
     }
+}
+
+/// Removes from `c` its components along the orthonormal `basis` (modified
+/// Gram–Schmidt) and returns them, one per basis vector.
+fn off_span<const N: usize>(basis: &[[f64; N]], c: &mut [f64; N]) -> [f64; N] {
+    let mut parts = [0.0; N];
+    for (e, part) in basis.iter().zip(parts.iter_mut()) {
+        *part = dot(e, c);
+        for (ci, ei) in c.iter_mut().zip(e) {
+            *ci -= *part * ei;
+        }
+    }
+    parts
 }
 
 /// The collision map v⁺ = (I − 2P) v.

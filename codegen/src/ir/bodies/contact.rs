@@ -12,6 +12,13 @@ use super::frames::{self, Vec3, cross, dot, minus, plus, scale};
 use super::sym::{Sym, div, int, mul, square, sub};
 use super::{Body, Layer, structure};
 
+/// A surface by shape: a plane (unit normal, offset, the normal's largest
+/// axis), or a sphere or cylinder (centre, a cylinder's axis, radius).
+enum Shape {
+    Plane(Vec3, Sym, usize),
+    Round(Vec3, Option<Vec3>, Sym),
+}
+
 impl Layer<'_> {
     /// The body a constraint or wall names.
     fn find(&mut self, body: &Spanned<String>) -> Option<Body> {
@@ -108,6 +115,22 @@ impl Layer<'_> {
         Some((c, axis, big))
     }
 
+    /// The surface a body rolls on or meets, by the one shape given (the
+    /// caller checks there is one).
+    fn shape(
+        &mut self,
+        plane: &Option<Spanned<PlaneDecl>>,
+        sphere: &Option<Spanned<RoundDecl>>,
+        cylinder: &Option<Spanned<RoundDecl>>,
+    ) -> Option<Shape> {
+        if let Some(p) = plane {
+            let (n, offset, k) = self.plane(p)?;
+            return Some(Shape::Plane(n, offset, k));
+        }
+        let (c, axis, big) = self.round(sphere, cylinder)?;
+        Some(Shape::Round(c, axis, big))
+    }
+
     /// Rows saying that the point at `offset` from the centre of `body` is
     /// at rest, except its component along `normal`: the components across
     /// the normal's largest axis `k` (with the normal's row, they span all
@@ -133,21 +156,8 @@ impl Layer<'_> {
             );
             return;
         }
-        let plane = match &r.plane {
-            Some(p) => {
-                let Some(plane) = self.plane(p) else { return };
-                Some(plane)
-            }
-            None => None,
-        };
-        let round = match plane {
-            Some(_) => None,
-            None => {
-                let Some(round) = self.round(&r.sphere, &r.cylinder) else {
-                    return;
-                };
-                Some(round)
-            }
+        let Some(shape) = self.shape(&r.plane, &r.sphere, &r.cylinder) else {
+            return;
         };
         let Some(body) = self.find(&r.body) else {
             return;
@@ -162,20 +172,12 @@ impl Layer<'_> {
             );
             return;
         };
-        let rows = match (plane, round) {
-            (Some((n, offset, k)), _) => {
-                let Some(rows) = self.on_plane(decl, &body, &radius, &n, &offset, k) else {
-                    return;
-                };
-                rows
-            }
-            (None, Some((c, axis, big))) => {
-                let Some(rows) = self.inside(decl, &body, &radius, &c, axis.as_ref(), &big) else {
-                    return;
-                };
-                rows
-            }
-            (None, None) => return,
+        let rows = match &shape {
+            Shape::Plane(n, offset, k) => self.on_plane(decl, &body, &radius, n, offset, *k),
+            Shape::Round(c, axis, big) => self.inside(decl, &body, &radius, c, axis.as_ref(), big),
+        };
+        let Some(rows) = rows else {
+            return;
         };
         for row in rows {
             self.out
@@ -258,7 +260,6 @@ impl Layer<'_> {
         }
         let Some(t) = self
             .coordinates
-            .clone()
             .iter()
             .map(|q| body.position.clone().map(|x| x.derivative(q)))
             .find(|t| t.iter().any(|x| !x.is_zero()))
@@ -371,20 +372,8 @@ impl Layer<'_> {
             }
         };
         // The geometry first (it needs `self` mutably), then the body.
-        enum Shape {
-            Plane(Vec3, Sym, usize),
-            Round(Vec3, Option<Vec3>, Sym),
-        }
-        let shape = if let Some(p) = &w.plane {
-            let Some((n, offset, k)) = self.plane(p) else {
-                return;
-            };
-            Shape::Plane(n, offset, k)
-        } else {
-            let Some((c, axis, big)) = self.round(&w.sphere, &w.cylinder) else {
-                return;
-            };
-            Shape::Round(c, axis, big)
+        let Some(shape) = self.shape(&w.plane, &w.sphere, &w.cylinder) else {
+            return;
         };
         let Some(body) = self.find(&body_name) else {
             return;
