@@ -29,6 +29,7 @@ pub mod inspect;
 mod lower;
 mod mechanics;
 mod output;
+mod probe;
 mod sample;
 mod symbols;
 mod walls;
@@ -351,8 +352,12 @@ impl Compiler<'_> {
     }
 }
 
-/// Whether `a` is zero as a rational function.
+/// Whether `a` is zero as a rational function (a value at a point first,
+/// which settles most "no"s without the expansion).
 fn is_zero(a: &Atom) -> bool {
+    if probe::nonzero(a) {
+        return false;
+    }
     let r: Rat = a.expand().to_rational_polynomial(&Q, &Z, None);
     r.numerator.is_zero()
 }
