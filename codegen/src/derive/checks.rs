@@ -19,7 +19,7 @@ use super::evaluate::program;
 use super::mechanics::Raw;
 use super::sample::onto;
 use super::symbols::Symbols;
-use super::{Field, Rat, is_zero, rows_matrix};
+use super::{Field, Rat, budget, is_zero, rows_matrix};
 use crate::diag::{Collector, ErrorKind, Reported};
 use crate::ir::Wall;
 use crate::program::Program;
@@ -48,7 +48,14 @@ pub fn kinetic_energy_quadratic(sym: &Symbols, cx: &mut Collector, t: &Atom, g: 
             quad += g[i][j].clone() * Atom::from(*vi) * Atom::from(*vj);
         }
     }
-    let rest = (t.clone() - quad / Atom::num(2)).expand();
+    let Ok(rest) = budget::expand(
+        &(t.clone() - quad / Atom::num(2)),
+        cx,
+        &span,
+        "the kinetic energy",
+    ) else {
+        return;
+    };
     if !is_zero(&rest) {
         cx.error(
             ErrorKind::NotQuadratic(format!(
@@ -60,14 +67,23 @@ pub fn kinetic_energy_quadratic(sym: &Symbols, cx: &mut Collector, t: &Atom, g: 
 }
 
 /// The coefficient row of a velocity-level expression, which must be
-/// linear and homogeneous in the velocities.
+/// linear and homogeneous in the velocities (`what` at `span` names it
+/// when its expansion is past the budget).
 pub fn linear_row(
     sym: &Symbols,
     cx: &mut Collector,
     e: &Atom,
     span: &Range<usize>,
+    what: &str,
 ) -> Result<Vec<Atom>, Reported> {
-    let row: Vec<Atom> = sym.vels.iter().map(|v| e.derivative(*v).expand()).collect();
+    let mut row = Vec::with_capacity(sym.vels.len());
+    let mut bound = 0.0;
+    for v in &sym.vels {
+        let d = e.derivative(*v);
+        bound += budget::expansion_terms(&d);
+        budget::within(bound, cx, span, what)?;
+        row.push(d.expand());
+    }
     for c in &row {
         for (k, v) in sym.vels.iter().enumerate() {
             if !is_zero(&c.derivative(*v)) {
@@ -85,7 +101,7 @@ pub fn linear_row(
     for (c, v) in row.iter().zip(&sym.vels) {
         lin += c.clone() * Atom::from(*v);
     }
-    let rest = (e.clone() - lin).expand();
+    let rest = budget::expand(&(e.clone() - lin), cx, span, what)?;
     if !is_zero(&rest) {
         return Err(cx.error(
             ErrorKind::NotLinear(format!("it has a part free of the velocities: {rest}")),

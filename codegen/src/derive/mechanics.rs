@@ -119,25 +119,43 @@ pub fn raw(sym: &Symbols, cx: &mut Collector) -> Result<Raw, Reported> {
 
     let mut a_rows = Vec::new();
     let mut a_labels = Vec::new();
+    let mut a_spans = Vec::new();
     let mut holonomic = Vec::new();
     for (k, c) in m.holonomic.iter().enumerate() {
         let h = sym.parse(c, cx)?;
         checks::no_velocity(sym, cx, &h, &c.span, ErrorKind::VelocityInHolonomic);
-        a_rows.push(
-            sym.coords
-                .iter()
-                .map(|q| h.derivative(*q).expand())
-                .collect::<Vec<_>>(),
-        );
-        a_labels.push(format!("holonomic constraint {}", k + 1));
+        let what = format!("holonomic constraint {}", k + 1);
+        let mut row = Vec::with_capacity(n);
+        let mut bound = 0.0;
+        for q in &sym.coords {
+            let d = h.derivative(*q);
+            bound += budget::expansion_terms(&d);
+            budget::within(bound, cx, &c.span, &what)?;
+            row.push(d.expand());
+        }
+        a_rows.push(row);
+        a_labels.push(what);
+        a_spans.push(c.span.clone());
         holonomic.push(h);
     }
     for (k, c) in m.constraints.iter().enumerate() {
         a_labels.push(format!("constraint {}", k + 1));
+        a_spans.push(c.span.clone());
         let e = sym.parse(c, cx)?;
-        a_rows.push(checks::linear_row(sym, cx, &e, &c.span)?);
+        a_rows.push(checks::linear_row(
+            sym,
+            cx,
+            &e,
+            &c.span,
+            &a_labels[a_labels.len() - 1],
+        )?);
     }
-    let (forcing, drift) = equations_of_motion(sym, &t, &v, &a_rows);
+    let forcing = forcing(sym, cx, &t, &v)?;
+    let drift = a_rows
+        .iter()
+        .zip(a_spans.iter().zip(&a_labels))
+        .map(|(row, (span, what))| drift(sym, cx, row, span, what))
+        .collect::<Result<Vec<_>, _>>()?;
     let walls = m
         .walls
         .iter()
@@ -187,14 +205,16 @@ fn raw_wall(sym: &Symbols, cx: &mut Collector, w: &Wall) -> Result<RawWall, Repo
                 .as_ref()
                 .ok_or_else(|| missing(cx, "normal_velocity"))?;
             let atom = sym.parse(e, cx)?;
-            let row = checks::linear_row(sym, cx, &atom, &e.span)?;
+            let what = format!("wall `{}`'s normal velocity", w.name);
+            let row = checks::linear_row(sym, cx, &atom, &e.span, &what)?;
             (Atom::num(0), row, Atom::num(0))
         }
     };
     let mut contact = Vec::new();
-    for c in &w.contact {
+    for (k, c) in w.contact.iter().enumerate() {
         let e = sym.parse(c, cx)?;
-        contact.push(checks::linear_row(sym, cx, &e, &c.span)?);
+        let what = format!("wall `{}`'s contact row {}", w.name, k + 1);
+        contact.push(checks::linear_row(sym, cx, &e, &c.span, &what)?);
     }
     Ok(RawWall {
         surface,
@@ -214,46 +234,68 @@ pub fn lagrangian_gradient(sym: &Symbols, raw: &Raw) -> Vec<Atom> {
         .collect()
 }
 
-/// The Lagrange–d'Alembert equations G q̈ + h = Aᵀλ with A q̇ = 0:
-/// hᵢ = Σₖ ∂²T/∂q̇ᵢ∂qₖ q̇ₖ − ∂T/∂qᵢ + ∂V/∂qᵢ, and differentiating A q̇ = 0
-/// in time gives A q̈ + Ȧq̇ = 0 with (Ȧq̇)ᵣ = Σⱼ ∂(Aᵣq̇)/∂qⱼ q̇ⱼ.
-/// An instantaneous model has no motion between collisions: both are zero.
-fn equations_of_motion(
-    sym: &Symbols,
-    t: &Atom,
-    v: &Atom,
-    a_rows: &[Vec<Atom>],
-) -> (Vec<Atom>, Vec<Atom>) {
+/// h of the Lagrange–d'Alembert equations G q̈ + h = Aᵀλ (with A q̇ = 0):
+/// hᵢ = Σₖ ∂²T/∂q̇ᵢ∂qₖ q̇ₖ − ∂T/∂qᵢ + ∂V/∂qᵢ, within the budget (checked
+/// after each derivative, at T's or V's declaration). An instantaneous
+/// model has no motion between collisions: zero.
+fn forcing(sym: &Symbols, cx: &mut Collector, t: &Atom, v: &Atom) -> Result<Vec<Atom>, Reported> {
     let n = sym.vels.len();
-    if sym.model.kind == Kind::Instantaneous {
-        return (vec![Atom::num(0); n], vec![Atom::num(0); a_rows.len()]);
+    let m = sym.model;
+    if m.kind == Kind::Instantaneous {
+        return Ok(vec![Atom::num(0); n]);
     }
-    let forcing = (0..n)
-        .map(|i| {
-            let q = sym.coords[i];
-            let ti = t.derivative(sym.vels[i]);
-            let mut h = v.derivative(q) - t.derivative(q);
-            for (k, qk) in sym.coords.iter().enumerate() {
-                h += ti.derivative(*qk) * sym.vel(k);
-            }
-            h
-        })
-        .collect();
-    let drift = a_rows
-        .iter()
-        .map(|row| {
-            let mut e = Atom::num(0);
-            for (k, a) in row.iter().enumerate() {
-                e += a.clone() * sym.vel(k);
-            }
-            let mut c = Atom::num(0);
-            for (j, qj) in sym.coords.iter().enumerate() {
-                c += e.derivative(*qj) * sym.vel(j);
-            }
-            c
-        })
-        .collect();
-    (forcing, drift)
+    let t_span = &m.kinetic_energy.span;
+    let v_span = m.potential.as_ref().map_or(t_span, |p| &p.span);
+    let (mut t_bound, mut v_bound) = (0.0, 0.0);
+    let mut out = Vec::with_capacity(n);
+    for i in 0..n {
+        let q = sym.coords[i];
+        let dv = v.derivative(q);
+        v_bound += budget::expansion_terms(&dv);
+        budget::within(v_bound, cx, v_span, "the potential")?;
+        let dt = t.derivative(q);
+        t_bound += budget::expansion_terms(&dt);
+        budget::within(t_bound, cx, t_span, "the kinetic energy")?;
+        let ti = t.derivative(sym.vels[i]);
+        let mut h = dv - dt;
+        for (k, qk) in sym.coords.iter().enumerate() {
+            let d = ti.derivative(*qk);
+            t_bound += budget::expansion_terms(&d);
+            budget::within(t_bound, cx, t_span, "the kinetic energy")?;
+            h += d * sym.vel(k);
+        }
+        out.push(h);
+    }
+    Ok(out)
+}
+
+/// Ȧq̇ of one row of A (differentiating A q̇ = 0 in time gives
+/// A q̈ + Ȧq̇ = 0): Σⱼ ∂(A_row q̇)/∂qⱼ q̇ⱼ, within the budget (checked after
+/// each derivative, at the row's declaration `span`, named `what`). Zero
+/// for an instantaneous model.
+fn drift(
+    sym: &Symbols,
+    cx: &mut Collector,
+    row: &[Atom],
+    span: &Range<usize>,
+    what: &str,
+) -> Result<Atom, Reported> {
+    if sym.model.kind == Kind::Instantaneous {
+        return Ok(Atom::num(0));
+    }
+    let mut e = Atom::num(0);
+    for (k, a) in row.iter().enumerate() {
+        e += a.clone() * sym.vel(k);
+    }
+    let mut c = Atom::num(0);
+    let mut bound = 0.0;
+    for (j, qj) in sym.coords.iter().enumerate() {
+        let d = e.derivative(*qj);
+        bound += budget::expansion_terms(&d);
+        budget::within(bound, cx, span, &format!("{what}'s rate"))?;
+        c += d * sym.vel(j);
+    }
+    Ok(c)
 }
 
 /// vᵀ∇²f(q)v from the normal df = `row`: Σₖ (Σᵢ ∂ₖ∂ᵢf vᵢ) vₖ, expanded
