@@ -325,6 +325,7 @@ fn interpreted_models_with_nonpolynomial_walls() {
     }
     for name in [
         "disk_log",
+        "disk_power",
         "disk_quotient",
         "disk_sin",
         "disk_sqrt",

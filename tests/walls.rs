@@ -245,6 +245,15 @@ fn sine_wall() {
     same_collisions::<2>("disk_sin", Some(9.81), 10.0, 6);
 }
 
+/// A power with a varying exponent, (x² + y²)^(1 + y²) (the evaluator's
+/// form of exp((1 + y²)·log(x² + y²))): the unit circle again, with a
+/// radial normal there, so the square-root disk's collisions.
+#[test]
+fn varying_exponent_wall() {
+    compare::<2>("disk_power", "disk_sqrt", None, 10.0, 6, methods());
+    compare::<2>("disk_power", "disk_sqrt", Some(9.81), 10.0, 6, methods());
+}
+
 /// Beyond the ring where f < 0 the tangent has a pole and is positive
 /// again (see `tests/walls/disk_tan.toml`): a Runge–Kutta step whose
 /// samples jumped the ring would see f > 0 at each, falling at each. The
@@ -343,6 +352,7 @@ fn no_state_outside_from_random_starts() {
         "disk_sqrt",
         "disk_quotient",
         "disk_log",
+        "disk_power",
         "oval_exp",
         "disk_sin",
         "disk_tan",

@@ -80,9 +80,28 @@ pub fn program(outputs: &[Atom], inputs: &[Atom]) -> Result<Program, String> {
         ESlot::Out(i) => Slot::Out(*i),
     };
     let slots = |v: &[ESlot]| v.iter().map(slot).collect::<Vec<_>>();
+    // Temporaries past the evaluator's own, for what one of its
+    // instructions becomes in several.
+    let mut fresh = ex
+        .instructions
+        .iter()
+        .flat_map(|ins| match ins {
+            Instruction::Add(d, s, _) | Instruction::Mul(d, s, _) => {
+                std::iter::once(d).chain(s.iter()).collect::<Vec<_>>()
+            }
+            Instruction::Pow(d, s, _, _) | Instruction::Assign(d, s) => vec![d, s],
+            Instruction::Powf(d, s, e, _) => vec![d, s, e],
+            _ => Vec::new(),
+        })
+        .filter_map(|s| match s {
+            ESlot::Temp(i) => Some(*i + 1),
+            _ => None,
+        })
+        .max()
+        .unwrap_or(0);
     let mut instrs = Vec::new();
     for ins in &ex.instructions {
-        instrs.push(match ins {
+        let one = match ins {
             Instruction::Add(d, s, _) => Instr::Add(slot(d), slots(s)),
             Instruction::Mul(d, s, _) => Instr::Mul(slot(d), slots(s)),
             Instruction::Pow(d, s, n, _) => Instr::Pow(slot(d), slot(s), *n),
@@ -90,7 +109,16 @@ pub fn program(outputs: &[Atom], inputs: &[Atom]) -> Result<Program, String> {
                 (_, Slot::Const(k)) => Instr::Powf(slot(d), slot(s), consts[k]),
                 // symbolica writes exp(x) as e^x.
                 (Slot::Const(k), x) if k == first_constant + 1 => Instr::Fun(slot(d), Func::Exp, x),
-                _ => return Err(format!("a power with a variable exponent: {ins:?}")),
+                // b^x with x varying (symbolica's form of exp(x·log b)):
+                // written back as exp(x·log b), in the functions the
+                // language has.
+                (b, x) => {
+                    let (log, product) = (Slot::Temp(fresh), Slot::Temp(fresh + 1));
+                    fresh += 2;
+                    instrs.push(Instr::Fun(log, Func::Log, b));
+                    instrs.push(Instr::Mul(product, vec![x, log]));
+                    Instr::Fun(slot(d), Func::Exp, product)
+                }
             },
             Instruction::Assign(d, s) => Instr::Assign(slot(d), slot(s)),
             Instruction::Fun(d, call, _) => {
@@ -104,7 +132,8 @@ pub fn program(outputs: &[Atom], inputs: &[Atom]) -> Result<Program, String> {
                 Instr::Fun(slot(d), func, slot(arg))
             }
             other => return Err(format!("unsupported evaluator instruction {other:?}")),
-        });
+        };
+        instrs.push(one);
     }
     Ok(Program {
         inputs: inputs.len(),
