@@ -8,6 +8,7 @@ use std::time::Instant;
 
 use clap::Args;
 use dalembert::runtime::prelude::*;
+use dalembert::runtime::saltation::StateMatrix;
 use dalembert::runtime::simulate::{SimError, Simulator, Variational};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -18,6 +19,7 @@ mod output;
 pub(crate) mod sensitivity;
 pub use output::Row;
 use output::{MAX_ROWS, Output};
+use sensitivity::Columns;
 
 #[derive(Args, Debug)]
 pub struct SimulateArgs {
@@ -45,6 +47,14 @@ pub struct SimulateArgs {
     /// 2N columns are integrated along every step.
     #[arg(long)]
     pub sensitivity: bool,
+    /// Entries of Φ to add to the CSV as columns `dA/dB(0)`: `A/B` pairs
+    /// separated by commas, the derivative of A at t by B at the start (A
+    /// and B coordinate or velocity names, e.g. `x/x,x/x_dot`), or `all`.
+    /// Follows Φ as `--sensitivity` does. Every row is then a step's end
+    /// (Taylor's method too stops a step at each row); the row just before
+    /// a collision has Φ just before it, the row after it Φ after it.
+    #[arg(long)]
+    pub phi: Option<String>,
 }
 
 /// Runs `dalembert simulate`.
@@ -103,15 +113,24 @@ fn run<M: Surfaces<N>, const N: usize>(
         .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
     let csv = args.out.join(format!("{}.csv", model.name()));
     let svg = args.out.join(format!("{}.svg", model.name()));
-    let mut out = Output::<N>::create(&model, &csv, e0)?;
-    out.push(Row {
-        t: 0.0,
-        q: start.q,
-        v: start.v,
-        energy: e0,
-        residual: [start_residual.velocity, start_residual.position],
-        event: None,
-    })?;
+    let columns = (args.phi.as_deref())
+        .map(|spec| Columns::parse(&model, spec))
+        .transpose()?;
+    let names = columns.as_ref().map_or(&[][..], |c| &c.names[..]);
+    let mut out = Output::<N>::create(&model, &csv, e0, names)?;
+    let mut phi = (args.sensitivity || columns.is_some()).then(|| Variational::new(args.run.rtol));
+    let entries = |m: &StateMatrix<N>| columns.as_ref().map_or(Vec::new(), |c| c.values(m));
+    out.push(
+        Row {
+            t: 0.0,
+            q: start.q,
+            v: start.v,
+            energy: e0,
+            residual: [start_residual.velocity, start_residual.position],
+            event: None,
+        },
+        &entries(&StateMatrix::identity()),
+    )?;
     // The output's bound, before a run that may be long.
     println!(
         "{}: writing {}: a row every {every} to t = {} ({} rows) and two per collision, at most {MAX_ROWS} rows",
@@ -123,14 +142,15 @@ fn run<M: Surfaces<N>, const N: usize>(
         (args.t_end / every * (1.0 - 1e-12)).ceil() as u64 + 1
     );
     let clock = Instant::now();
-    let dense = matches!(args.run.integrator, Method::Taylor);
-    let mut phi = args.sensitivity.then(|| Variational::new(args.run.rtol));
+    // Φ is known at the steps' ends only.
+    let dense = matches!(args.run.integrator, Method::Taylor) && columns.is_none();
     let failure = integrate(
         &mut sim,
         &model,
         (args.t_end, every, dense),
         &mut out,
         phi.as_mut(),
+        &entries,
     )?;
     let elapsed = clock.elapsed();
     out.finish()?;
@@ -164,6 +184,7 @@ fn integrate<'m, M: Surfaces<N>, const N: usize>(
     (t_end, every, dense): (f64, f64, bool),
     out: &mut Output<'m, N>,
     mut phi: Option<&mut Variational<N>>,
+    entries: &dyn Fn(&StateMatrix<N>) -> Vec<f64>,
 ) -> Result<Option<String>, String> {
     let bar = ProgressBar::new(1000);
     bar.set_style(
@@ -199,15 +220,25 @@ fn integrate<'m, M: Surfaces<N>, const N: usize>(
             let Some(s) = sim.state_at(grid(k)) else {
                 break;
             };
-            out.push(Row::of(model, s.t, s.q, s.v))?;
+            // (Only where Φ is not written: rows inside steps are dense.)
+            out.push(Row::of(model, s.t, s.q, s.v), &[])?;
             k += 1.0;
         }
+        let phi_now = phi
+            .as_deref()
+            .map(|p| (entries(p.before_collision()), entries(p.matrix())));
+        let (before, after) = phi_now
+            .as_ref()
+            .map_or((&[][..], &[][..]), |(b, a)| (&b[..], &a[..]));
         if let Some(c) = &step.collision {
             // The state just before the collision, from its record.
-            out.push(Row {
-                event: Some(model.wall_name(c.wall)),
-                ..Row::of(model, c.t, c.q, c.v_minus)
-            })?;
+            out.push(
+                Row {
+                    event: Some(model.wall_name(c.wall)),
+                    ..Row::of(model, c.t, c.q, c.v_minus)
+                },
+                before,
+            )?;
         }
         let s = &step.state;
         let energy = step.energy(model);
@@ -216,7 +247,7 @@ fn integrate<'m, M: Surfaces<N>, const N: usize>(
         }
         let on_grid = s.t >= grid(k);
         if on_grid || step.collision.is_some() || failure.is_some() {
-            out.push(Row::of(model, s.t, s.q, s.v))?;
+            out.push(Row::of(model, s.t, s.q, s.v), after)?;
         }
         if failure.is_some() {
             break;

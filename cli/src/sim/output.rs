@@ -62,7 +62,15 @@ pub(super) struct Output<'m, const N: usize> {
 }
 
 impl<'m, const N: usize> Output<'m, N> {
-    pub(super) fn create<M: Surfaces<N>>(model: &M, path: &Path, e0: f64) -> Result<Self, String> {
+    /// The CSV file at `path` with its header: t, the coordinates, the
+    /// velocities, energy, residuals, collision, then `extra` (columns
+    /// each row gives [`Output::push`] after its own).
+    pub(super) fn create<M: Surfaces<N>>(
+        model: &M,
+        path: &Path,
+        e0: f64,
+        extra: &[String],
+    ) -> Result<Self, String> {
         let file = std::fs::File::create(path)
             .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         let mut out = Self {
@@ -86,7 +94,12 @@ impl<'m, const N: usize> Output<'m, N> {
             header.push(',');
             header.push_str(name);
         }
-        header.push_str(",energy,residual_velocity,residual_position,collision\n");
+        header.push_str(",energy,residual_velocity,residual_position,collision");
+        for name in extra {
+            header.push(',');
+            header.push_str(name);
+        }
+        header.push('\n');
         out.write(header.as_bytes())?;
         Ok(out)
     }
@@ -97,7 +110,8 @@ impl<'m, const N: usize> Output<'m, N> {
             .map_err(|e| format!("cannot write {}: {e}", self.path.display()))
     }
 
-    pub(super) fn push(&mut self, r: Row<'m, N>) -> Result<(), String> {
+    /// Writes the row `r` and its `extra` columns (as many as the header's).
+    pub(super) fn push(&mut self, r: Row<'m, N>, extra: &[f64]) -> Result<(), String> {
         if self.written >= MAX_ROWS {
             return Err(format!(
                 "stopped at t = {}: the run has written {MAX_ROWS} rows to {} (collisions count as rows), the most a run may write; raise --every or shorten --t-end",
@@ -117,6 +131,10 @@ impl<'m, const N: usize> Output<'m, N> {
         }
         line.push(b',');
         line.extend_from_slice(r.event.unwrap_or("").as_bytes());
+        for &x in extra {
+            line.push(b',');
+            line.extend_from_slice(number.format(x).as_bytes());
+        }
         line.push(b'\n');
         self.write(&line)?;
         self.drift = self.drift.max((r.energy - self.e0).abs());
@@ -180,16 +198,19 @@ mod tests {
     /// `rows` rows at t = 0, 1, …, a collision wherever `collision(t)`.
     fn pushed(name: &str, rows: usize, collision: impl Fn(usize) -> bool) -> Output<'static, 2> {
         let path = std::env::temp_dir().join(format!("dalembert-output-{name}.csv"));
-        let mut out = Output::create(&PendulumWall::default(), &path, 0.0).unwrap();
+        let mut out = Output::create(&PendulumWall::default(), &path, 0.0, &[]).unwrap();
         for t in 0..rows {
-            out.push(Row {
-                t: t as f64,
-                q: [0.0; 2],
-                v: [0.0; 2],
-                energy: 0.0,
-                residual: [0.0; 2],
-                event: collision(t).then_some("wall"),
-            })
+            out.push(
+                Row {
+                    t: t as f64,
+                    q: [0.0; 2],
+                    v: [0.0; 2],
+                    energy: 0.0,
+                    residual: [0.0; 2],
+                    event: collision(t).then_some("wall"),
+                },
+                &[],
+            )
             .unwrap();
             assert!(
                 out.kept.len() <= 2 * PLOT_ROWS,

@@ -37,6 +37,8 @@ use crate::saltation::{SaltationError, StateMatrix, saltation};
 #[derive(Clone, Copy, Debug)]
 pub struct Variational<const N: usize> {
     phi: StateMatrix<N>,
+    /// Φ at the end of the last step's flight: before its collision.
+    before: StateMatrix<N>,
     method: DormandPrince,
     /// The last accepted length of a step of Φ's integration.
     h: f64,
@@ -73,6 +75,7 @@ impl<const N: usize> Variational<N> {
     pub fn new(rtol: f64) -> Self {
         Self {
             phi: StateMatrix::identity(),
+            before: StateMatrix::identity(),
             method: DormandPrince {
                 rtol,
                 atol: rtol * 1e-2,
@@ -85,6 +88,13 @@ impl<const N: usize> Variational<N> {
     /// Φ so far: ∂x/∂x₀ over (q, q̇) as four N×N blocks.
     pub fn matrix(&self) -> &StateMatrix<N> {
         &self.phi
+    }
+
+    /// Φ just before the last step's collision, Φ⁻ (the saltation gives
+    /// [`Variational::matrix`] = S Φ⁻); [`Variational::matrix`] itself
+    /// when the step met no wall.
+    pub fn before_collision(&self) -> &StateMatrix<N> {
+        &self.before
     }
 
     /// Advances Φ over `step`, the step `sim` has just made: along its
@@ -102,6 +112,7 @@ impl<const N: usize> Variational<N> {
                 self.set_column(j, &column);
             }
         }
+        self.before = self.phi;
         if let Some(c) = &step.collision {
             let s = saltation(sim.model(), c.wall, &c.q, &c.v_minus).map_err(|error| {
                 VariationalError::Saltation {
