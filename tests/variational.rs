@@ -288,3 +288,71 @@ fn the_spinning_ball_on_the_rough_floor() {
     let v: [f64; 6] = std::array::from_fn(|_| lcg(&mut s) - 0.5);
     check(&m, (q, v), 8.0);
 }
+
+/// The energy identity ∇E(x(t))ᵀ Φ(t) δx₀ = ∇E(x₀)ᵀ δx₀ at the end of every
+/// step of 10⁴ bounces of the spinning ball on the rough floor from its
+/// model file's start (§3.2's superball law at each), with Taylor's method
+/// and Dormand–Prince, along three admissible directions; and Φ δx₀
+/// tangent to the constraints at the end. Φ grows along the run (the
+/// bounce period moves with the energy), so the bound is relative to
+/// |∇E(x(t))|·|Φ δx₀|.
+#[test]
+fn energy_is_kept_through_ten_thousand_bounces() {
+    let m = BallBounce::default();
+    let start = common::initial(&m);
+    let x0 = (start.q, start.v);
+    let mut seed = 29_u64;
+    let directions: Vec<_> = (0..3)
+        .map(|_| admissible_direction(&m, &x0.0, &x0.1, &mut seed).expect("a direction"))
+        .collect();
+    let dot = |(a, b): &([f64; 6], [f64; 6]), (c, d): (&[f64; 6], &[f64; 6])| -> f64 {
+        (0..6).map(|i| a[i] * c[i] + b[i] * d[i]).sum()
+    };
+    let largest = |x: &[f64]| x.iter().fold(0.0_f64, |a, y| a.max(y.abs()));
+    let ge0 = energy_gradient(&m, &x0.0, &x0.1);
+    let before: Vec<f64> = directions
+        .iter()
+        .map(|(dq, dv)| dot(&ge0, (dq, dv)))
+        .collect();
+    for (method, settings, _, _) in integrators().into_iter().take(2) {
+        let mut sim = Simulator::new(&m, start, settings).unwrap();
+        let mut phi = Variational::new(1e-12);
+        let (mut bounces, mut worst, mut growth) = (0, 0.0_f64, 0.0_f64);
+        while bounces < 10_000 {
+            // (10⁴ bounces end near t = 4078.)
+            let step = sim.step(1e4).unwrap();
+            bounces += usize::from(step.collision.is_some());
+            phi.follow(&sim, &step).unwrap();
+            let s = sim.state();
+            let ge = energy_gradient(&m, &s.q, &s.v);
+            let size = largest(&ge.0).max(largest(&ge.1));
+            for ((dq, dv), e0) in directions.iter().zip(&before) {
+                let (pq, pv) = phi.matrix().apply(dq, dv);
+                let norm = largest(&pq).max(largest(&pv));
+                growth = growth.max(norm);
+                worst = worst.max((dot(&ge, (&pq, &pv)) - e0).abs() / (size * norm + e0.abs()));
+            }
+        }
+        eprintln!(
+            "{method}: 10⁴ bounces to t = {:.1}, largest |Φ δx₀| {growth:.1e}, largest |∇E·Φδx₀ − ∇E₀·δx₀| / (|∇E||Φδx₀|) = {worst:.1e}",
+            sim.state().t
+        );
+        assert!(worst <= 1e-6, "{method}: {worst:e}");
+        // Still tangent to the rolling rows at the end.
+        let s = sim.state();
+        let a = m.constraints(&s.q);
+        for (dq, dv) in &directions {
+            let (pq, pv) = phi.matrix().apply(dq, dv);
+            let along = |h: f64| {
+                let q: [f64; 6] = std::array::from_fn(|i| s.q[i] + h * pq[i]);
+                m.constraints(&q).apply(&s.v)
+            };
+            let (plus, minus, av) = (along(1e-6), along(-1e-6), a.apply(&pv));
+            let scale = largest(&pq).max(largest(&pv));
+            for r in 0..a.len() {
+                let rate = av.as_slice()[r] + (plus.as_slice()[r] - minus.as_slice()[r]) / 2e-6;
+                assert!(rate.abs() <= 1e-6 * scale, "{method}: row {r}: {rate:e}");
+            }
+        }
+    }
+}
