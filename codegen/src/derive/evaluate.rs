@@ -91,6 +91,8 @@ pub fn program(outputs: &[Atom], inputs: &[Atom]) -> Result<Program, String> {
             }
             Instruction::Pow(d, s, _, _) | Instruction::Assign(d, s) => vec![d, s],
             Instruction::Powf(d, s, e, _) => vec![d, s, e],
+            Instruction::Fun(d, call, _) => std::iter::once(d).chain(call.2.iter()).collect(),
+            // (Refused below.)
             _ => Vec::new(),
         })
         .filter_map(|s| match s {
@@ -141,4 +143,43 @@ pub fn program(outputs: &[Atom], inputs: &[Atom]) -> Result<Program, String> {
         instrs,
         outputs: ex.output_count,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::derive::build::{Namespace, own_symbol};
+
+    /// A power with a varying exponent, alone and among functions whose
+    /// results take the evaluator's temporaries, evaluates as exp(x·log y):
+    /// the temporaries it is written in are fresh.
+    #[test]
+    fn varying_exponents_are_exp_of_log() {
+        crate::lock::acquire().unwrap();
+        let _ns = Namespace::enter("evaluate test");
+        let [x, y] = ["x", "y"].map(|n| Atom::from(own_symbol(n)));
+        let power = function!(Symbol::EXP, &x * function!(Symbol::LOG, &y));
+        let sin_xy = function!(Symbol::SIN, &x * &y);
+        let outputs = [
+            power.clone(),
+            function!(Symbol::SIN, &power + function!(Symbol::COS, &x * &y)) * &power
+                + function!(Symbol::SIN, &x),
+            // A function's result read after the power.
+            &power * &sin_xy + &sin_xy,
+        ];
+        let p = program(&outputs, &[x, y]).unwrap();
+        for (a, b) in [(0.3, 1.7), (-1.2, 0.4), (2.5, 3.0)] {
+            let z = f64::powf(b, a);
+            let s = (a * b).sin();
+            let want = [z, (z + (a * b).cos()).sin() * z + a.sin(), z * s + s];
+            let got = p.eval(&[a, b]);
+            for (g, w) in got.iter().zip(want) {
+                // (sin of 16 carries the rounding of z, about 1e-15, times 16.)
+                assert!(
+                    (g - w).abs() <= 1e-12 * w.abs().max(1.0),
+                    "{got:?} against {want:?}"
+                );
+            }
+        }
+    }
 }
