@@ -462,3 +462,46 @@ fn the_box_is_the_same_box_at_every_scale() {
         }
     }
 }
+
+/// Stepping to the next collision, whenever it comes (`t_end` infinite),
+/// with every method: the same bounces at n·(2·2/g) as a run to a finite
+/// end. Taylor's method evaluated a flight's exact series at τ = ∞ there
+/// (its series bounds no step) and failed with a non-finite state.
+#[test]
+fn stepping_to_the_next_collision_needs_no_end() {
+    let ball = BallBounce::default();
+    let start = initial(&ball);
+    let flight = 2.0 * 2.0 / ball.params().g;
+    let methods = [
+        Settings::default(),
+        Settings {
+            integrator: Integrator::Taylor(Default::default()),
+            ..Settings::default()
+        },
+        Settings {
+            integrator: Integrator::Rk4(Rk4 { step: 1e-3 }),
+            ..Settings::default()
+        },
+    ];
+    for settings in methods {
+        let mut sim = Simulator::new(&ball, start, settings).unwrap();
+        for n in 1..=5 {
+            let step = loop {
+                let step = sim
+                    .step(f64::INFINITY)
+                    .unwrap_or_else(|e| panic!("{:?}: {e:?}", settings.integrator));
+                assert!(step.state.t.is_finite());
+                if step.collision.is_some() {
+                    break step;
+                }
+            };
+            let c = step.collision.unwrap();
+            assert!(
+                (c.t - n as f64 * flight).abs() <= 1e-9 * c.t,
+                "{:?}: bounce {n} at {}",
+                settings.integrator,
+                c.t
+            );
+        }
+    }
+}

@@ -10,7 +10,9 @@ use super::events::{Scan, SeriesStep};
 use super::integrator::{Plan, Reach};
 use super::phase::Phase;
 use super::roots::first_root;
-use super::thresholds::{ON_WALL_ULPS, POLISH_STEPS, SERIES_CHECK, TAYLOR_REACH, step_too_small};
+use super::thresholds::{
+    LONGEST_SERIES_STEP, ON_WALL_ULPS, POLISH_STEPS, SERIES_CHECK, TAYLOR_REACH, step_too_small,
+};
 use super::{SimError, Simulator, State, Step};
 use crate::dynamics::DynamicsError;
 use crate::taylor::{CAPACITY, Coefficients, Series, degree, eval_with_derivative};
@@ -418,12 +420,13 @@ impl Limit<'_> {
         Ok(h)
     }
 
-    /// The step's length, at most `left`, unchecked.
+    /// The step's length, at most `left` and [`LONGEST_SERIES_STEP`],
+    /// unchecked.
     fn length_or_nan(&mut self) -> f64 {
         let (plan, reach, left) = (self.plan, &self.reach, self.left);
         *self
             .length
-            .get_or_insert_with(|| plan.length(reach).min(left))
+            .get_or_insert_with(|| plan.length(reach).min(left).min(LONGEST_SERIES_STEP))
     }
 
     /// Bounds the step by one more series along it, a wall's f

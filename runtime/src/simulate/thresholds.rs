@@ -18,6 +18,12 @@ pub const ON_WALL: f64 = 1e-12;
 /// trusted up to this fraction of h (its error is O(δ³) in q, O(δ²) in q̇).
 pub const TAYLOR_REACH: f64 = 1e-6;
 
+/// The longest step Taylor's method takes. A series that ends (a flight
+/// under uniform gravity, or a free one) bounds no step, since it is exact
+/// over any; without this bound, a step towards an infinite `t_end` (to the
+/// next collision, whenever it comes) would be evaluated at τ = ∞.
+pub const LONGEST_SERIES_STEP: f64 = 1e6;
+
 /// Newton steps on f at most when a collision is polished.
 pub const POLISH_STEPS: usize = 6;
 
