@@ -63,6 +63,28 @@ pub fn within(
     Ok(())
 }
 
+/// The bound of a sum whose terms are made one at a time (derivatives, as
+/// a row or a form is built): each term's [`expansion_terms`] is added as
+/// it is made, so that a sum past [`MAX_EXPANDED_TERMS`] stops at the term
+/// that takes it there.
+#[derive(Default)]
+pub struct Running(f64);
+
+impl Running {
+    /// Adds `term`'s bound: an error at `span` naming `what` once the sum's
+    /// is past the limit.
+    pub fn add(
+        &mut self,
+        term: &Atom,
+        cx: &mut Collector,
+        span: &Range<usize>,
+        what: &str,
+    ) -> Result<(), Reported> {
+        self.0 += expansion_terms(term);
+        within(self.0, cx, span, what)
+    }
+}
+
 /// (terms of the view's own expansion, largest expansion inside a power
 /// or function that stays unexpanded at this level).
 fn terms(a: AtomView) -> (f64, f64) {

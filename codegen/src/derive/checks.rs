@@ -77,11 +77,10 @@ pub fn linear_row(
     what: &str,
 ) -> Result<Vec<Atom>, Reported> {
     let mut row = Vec::with_capacity(sym.vels.len());
-    let mut bound = 0.0;
+    let mut bound = budget::Running::default();
     for v in &sym.vels {
         let d = e.derivative(*v);
-        bound += budget::expansion_terms(&d);
-        budget::within(bound, cx, span, what)?;
+        bound.add(&d, cx, span, what)?;
         row.push(d.expand());
     }
     for c in &row {

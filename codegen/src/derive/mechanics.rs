@@ -126,11 +126,10 @@ pub fn raw(sym: &Symbols, cx: &mut Collector) -> Result<Raw, Reported> {
         checks::no_velocity(sym, cx, &h, &c.span, ErrorKind::VelocityInHolonomic);
         let what = format!("holonomic constraint {}", k + 1);
         let mut row = Vec::with_capacity(n);
-        let mut bound = 0.0;
+        let mut bound = budget::Running::default();
         for q in &sym.coords {
             let d = h.derivative(*q);
-            bound += budget::expansion_terms(&d);
-            budget::within(bound, cx, &c.span, &what)?;
+            bound.add(&d, cx, &c.span, &what)?;
             row.push(d.expand());
         }
         a_rows.push(row);
@@ -246,22 +245,19 @@ fn forcing(sym: &Symbols, cx: &mut Collector, t: &Atom, v: &Atom) -> Result<Vec<
     }
     let t_span = &m.kinetic_energy.span;
     let v_span = m.potential.as_ref().map_or(t_span, |p| &p.span);
-    let (mut t_bound, mut v_bound) = (0.0, 0.0);
+    let (mut t_bound, mut v_bound) = (budget::Running::default(), budget::Running::default());
     let mut out = Vec::with_capacity(n);
     for i in 0..n {
         let q = sym.coords[i];
         let dv = v.derivative(q);
-        v_bound += budget::expansion_terms(&dv);
-        budget::within(v_bound, cx, v_span, "the potential")?;
+        v_bound.add(&dv, cx, v_span, "the potential")?;
         let dt = t.derivative(q);
-        t_bound += budget::expansion_terms(&dt);
-        budget::within(t_bound, cx, t_span, "the kinetic energy")?;
+        t_bound.add(&dt, cx, t_span, "the kinetic energy")?;
         let ti = t.derivative(sym.vels[i]);
         let mut h = dv - dt;
         for (k, qk) in sym.coords.iter().enumerate() {
             let d = ti.derivative(*qk);
-            t_bound += budget::expansion_terms(&d);
-            budget::within(t_bound, cx, t_span, "the kinetic energy")?;
+            t_bound.add(&d, cx, t_span, "the kinetic energy")?;
             h += d * sym.vel(k);
         }
         out.push(h);
@@ -288,11 +284,11 @@ fn drift(
         e += a.clone() * sym.vel(k);
     }
     let mut c = Atom::num(0);
-    let mut bound = 0.0;
+    let mut bound = budget::Running::default();
+    let rate = format!("{what}'s rate");
     for (j, qj) in sym.coords.iter().enumerate() {
         let d = e.derivative(*qj);
-        bound += budget::expansion_terms(&d);
-        budget::within(bound, cx, span, &format!("{what}'s rate"))?;
+        bound.add(&d, cx, span, &rate)?;
         c += d * sym.vel(j);
     }
     Ok(c)
@@ -309,13 +305,12 @@ fn hessian_form(
     what: &str,
 ) -> Result<Atom, Reported> {
     let mut form = Atom::num(0);
-    let mut bound = 0.0;
+    let mut bound = budget::Running::default();
     for (k, entry) in row.iter().enumerate() {
         let mut rate = Atom::num(0);
         for (i, q) in sym.coords.iter().enumerate() {
             let d = entry.derivative(*q);
-            bound += budget::expansion_terms(&d);
-            budget::within(bound, cx, span, what)?;
+            bound.add(&d, cx, span, what)?;
             rate += d * sym.vel(i);
         }
         form += rate * sym.vel(k);
