@@ -43,6 +43,33 @@ pub fn expand(
     Ok(a.expand())
 }
 
+/// An expansion refused before it was made, for a caller to report at its
+/// declaration ([`Over::report`]): the bound on its terms, past
+/// [`MAX_EXPANDED_TERMS`].
+#[derive(Debug, Clone, Copy)]
+pub struct Over(pub f64);
+
+impl Over {
+    /// The error at `span` naming `what`, the bound and the limit.
+    pub fn report(self, cx: &mut Collector, span: &Range<usize>, what: &str) -> Reported {
+        let Self(bound) = self;
+        cx.error(
+            ErrorKind::Limit(format!(
+                "{what} may expand to {bound:.0} terms in the derivation; the limit is {MAX_EXPANDED_TERMS:.0}"
+            )),
+            Some(span.clone()),
+        )
+    }
+}
+
+/// [`Over`] when `bound` terms exceed [`MAX_EXPANDED_TERMS`].
+pub fn check(bound: f64) -> Result<(), Over> {
+    if bound > MAX_EXPANDED_TERMS {
+        return Err(Over(bound));
+    }
+    Ok(())
+}
+
 /// An error at `span` naming `what` and the limit when `bound` terms
 /// exceed [`MAX_EXPANDED_TERMS`] (a sum's bound, checked as its terms are
 /// made, stops the work before the sum is whole).
@@ -52,15 +79,7 @@ pub fn within(
     span: &Range<usize>,
     what: &str,
 ) -> Result<(), Reported> {
-    if bound > MAX_EXPANDED_TERMS {
-        return Err(cx.error(
-            ErrorKind::Limit(format!(
-                "{what} may expand to {bound:.0} terms in the derivation; the limit is {MAX_EXPANDED_TERMS:.0}"
-            )),
-            Some(span.clone()),
-        ));
-    }
-    Ok(())
+    check(bound).map_err(|o| o.report(cx, span, what))
 }
 
 /// The bound of a sum whose terms are made one at a time (derivatives, as

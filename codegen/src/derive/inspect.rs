@@ -8,6 +8,7 @@ use std::collections::HashMap;
 
 use symbolica::prelude::*;
 
+use super::budget;
 use super::build::{build, model_symbol};
 use super::evaluate::program;
 use super::lower::vanishes;
@@ -45,7 +46,12 @@ pub fn same_with(a: &str, b: &str, definitions: &[(String, String)]) -> Result<b
         let value = atom_with(text, &defs)?;
         defs.insert(name.clone(), value);
     }
-    Ok(vanishes(&(atom_with(a, &defs)? - atom_with(b, &defs)?)))
+    vanishes(&(atom_with(a, &defs)? - atom_with(b, &defs)?)).map_err(|budget::Over(bound)| {
+        format!(
+            "the difference, reduced by sin² + cos² = 1, may expand to {bound:.0} terms; the limit is {:.0}",
+            budget::MAX_EXPANDED_TERMS
+        )
+    })
 }
 
 /// `a` and `b` (with `definitions` as in [`same_with`]) evaluated at each

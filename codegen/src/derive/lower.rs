@@ -11,6 +11,7 @@ use std::sync::Arc;
 
 use symbolica::prelude::*;
 
+use super::budget::{self, Over};
 use super::build::{constant_symbol, own_constants, own_symbol};
 use super::mechanics::Raw;
 use super::symbols::Symbols;
@@ -133,33 +134,39 @@ impl Lowering {
     /// polynomial is expanded again. (Taking two powers of c per round of
     /// rewriting and expanding, cos(x)¹⁰⁰·cos(y)¹⁰⁰·cos(z)¹⁰⁰ in T took 49
     /// expansions of a growing polynomial per entry and ran past 120 s.)
-    fn reduce_trig(&self, a: &Atom) -> Atom {
+    ///
+    /// The reduction can multiply terms out (c¹⁰⁰ is 51 terms in s), so each
+    /// rewrite is bounded by [`budget::MAX_EXPANDED_TERMS`] before it is
+    /// expanded: [`Over`] past it.
+    fn reduce_trig(&self, a: &Atom) -> Result<Atom, Over> {
         let mut a = a.expand();
         for (s, c) in &self.trig_pairs {
-            a = fold_cos(a.as_view(), *c, *s).expand();
+            let folded = fold_cos(a.as_view(), *c, *s);
+            budget::check(budget::expansion_terms(&folded))?;
+            a = folded.expand();
         }
-        a
+        Ok(a)
     }
 
     /// A rational function in lowest terms, sin² + cos² = 1 reduced,
-    /// functions raised.
-    pub fn simplify(&self, r: &Rat) -> Atom {
-        let num = self.reduce_trig(&r.numerator.to_expression());
-        let den = self.reduce_trig(&r.denominator.to_expression());
+    /// functions raised; [`Over`] where the reduction is past the budget.
+    pub fn simplify(&self, r: &Rat) -> Result<Atom, Over> {
+        let num = self.reduce_trig(&r.numerator.to_expression())?;
+        let den = self.reduce_trig(&r.denominator.to_expression())?;
         let reduced = self.rat(&(num / den));
-        self.raise(&reduced.to_expression())
+        Ok(self.raise(&reduced.to_expression()))
     }
 
     /// [`Lowering::simplify`] of an expression.
-    pub fn reduce(&self, a: &Atom) -> Atom {
+    pub fn reduce(&self, a: &Atom) -> Result<Atom, Over> {
         self.simplify(&self.to_rat(a))
     }
 
     /// v⁺ component printed as a combination of the velocities.
-    pub fn collect_velocities(&self, sym: &Symbols, c: &Atom) -> String {
+    pub fn collect_velocities(&self, sym: &Symbols, c: &Atom) -> Result<String, Over> {
         let mut terms = Vec::new();
         for (k, v) in sym.vels.iter().enumerate() {
-            let coeff = self.reduce(&c.derivative(*v));
+            let coeff = self.reduce(&c.derivative(*v))?;
             if is_zero(&coeff) {
                 continue;
             }
@@ -172,22 +179,29 @@ impl Lowering {
                 terms.push(format!("({coeff})*{name}"));
             }
         }
-        if terms.is_empty() {
+        Ok(if terms.is_empty() {
             "0".into()
         } else {
             terms.join(" + ")
-        }
+        })
     }
 }
 
+/// What a reduction past the budget names in its error: `what` (a
+/// quantity), reduced by sin² + cos² = 1.
+pub fn reduced(what: &str) -> String {
+    format!("{what}, reduced by sin² + cos² = 1,")
+}
+
 /// Whether `a` is zero as a rational function of its symbols and function
-/// applications, sin² + cos² = 1 reduced.
-pub fn vanishes(a: &Atom) -> bool {
+/// applications, sin² + cos² = 1 reduced; [`Over`] where the reduction is
+/// past the budget.
+pub fn vanishes(a: &Atom) -> Result<bool, Over> {
     let a = own_constants(a);
     let low = Lowering::of(std::slice::from_ref(&a), Vec::new());
     let r: Rat = low.lower(&a).to_rational_polynomial(&Q, &Z, None);
-    let numerator = low.reduce_trig(&r.numerator.to_expression());
-    is_zero(&numerator)
+    let numerator = low.reduce_trig(&r.numerator.to_expression())?;
+    Ok(is_zero(&numerator))
 }
 
 /// `a` with every power cⁿ (n ≥ 2, an integer) of the symbol `c` written

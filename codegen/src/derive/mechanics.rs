@@ -8,7 +8,7 @@ use std::ops::Range;
 
 use symbolica::prelude::*;
 
-use super::lower::Lowering;
+use super::lower::{self, Lowering};
 use super::symbols::Symbols;
 use super::{Field, Rat, is_zero, rows_matrix};
 use super::{budget, checks};
@@ -354,11 +354,13 @@ pub fn exact(
         .iter()
         .map(|r| r.iter().map(|x| low.to_rat(x)).collect())
         .collect();
-    let g: Vec<Vec<Atom>> = raw
-        .g
-        .iter()
+    let g = (raw.g.iter())
         .map(|r| r.iter().map(|x| low.reduce(x)).collect())
-        .collect();
+        .collect::<Result<Vec<Vec<Atom>>, _>>()
+        .map_err(|o| {
+            let what = lower::reduced("the mass matrix");
+            o.report(cx, &m.kinetic_energy.span, &what)
+        })?;
     // An exact G⁻¹ is attempted only within its budget: asked for, a
     // closed form past it is an error; chosen, it gives way to structured
     // evaluation.
@@ -462,8 +464,14 @@ pub fn accelerations(
         let c = column(&raw.drift).ok_or_else(|| fail("Ȧq̇ as a column"))?;
         Some((a, c))
     };
-    Ok(solve_motion(g_inv, constrained.as_ref(), &neg_h)
-        .map(|x| (0..n).map(|i| low.simplify(&x[(i as u32, 0)])).collect()))
+    let Some(x) = solve_motion(g_inv, constrained.as_ref(), &neg_h) else {
+        return Ok(None);
+    };
+    let q_ddot = (0..n).map(|i| low.simplify(&x[(i as u32, 0)]));
+    q_ddot.collect::<Result<_, _>>().map(Some).map_err(|o| {
+        let what = lower::reduced("the accelerations q̈");
+        o.report(cx, &sym.model.kinetic_energy.span, &what)
+    })
 }
 
 /// q̈ of G q̈ + h = Aᵀλ, A q̈ + Ȧq̇ = 0, from −h and (A, −Ȧq̇): with

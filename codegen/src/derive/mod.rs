@@ -99,9 +99,14 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
     let accelerations = mechanics::accelerations(&sym, &low, &raw, &exact, g_inv.as_ref(), cx)?;
     let a_flat: Vec<Atom> = raw.a_rows.iter().flatten().cloned().collect();
     let mut functions = vec![Some(mass_matrix)];
+    let reduced_t = (low.reduce(&raw.t))
+        .map_err(|o| o.report(cx, t_span, &lower::reduced("the kinetic energy")))?;
+    let v_span = model.potential.as_ref().map_or(t_span, |v| &v.span);
+    let reduced_v =
+        (low.reduce(&raw.v)).map_err(|o| o.report(cx, v_span, &lower::reduced("the potential")))?;
     for (quantity, outputs, rows) in [
-        (Quantity::KineticEnergy, vec![low.reduce(&raw.t)], 0),
-        (Quantity::Potential, vec![low.reduce(&raw.v)], 0),
+        (Quantity::KineticEnergy, vec![reduced_t], 0),
+        (Quantity::Potential, vec![reduced_v], 0),
         (Quantity::Constraints, a_flat, raw.a_rows.len()),
         (
             Quantity::Holonomic,

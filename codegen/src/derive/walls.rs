@@ -5,9 +5,10 @@
 
 use symbolica::prelude::*;
 
+use super::budget::Over;
 use super::checks::{self, WallRows};
 use super::elimination;
-use super::lower::Lowering;
+use super::lower::{self, Lowering};
 use super::mechanics::{Exact, Raw, RawWall};
 use super::output::{Form, Function, Geometry, Projection, WallDerivation};
 use super::symbols::Symbols;
@@ -71,8 +72,11 @@ fn wall(
         ));
     }
     let closed = match c.g_inv {
-        Some(g_inv) => Some(closed_form(sym, low, g_inv, &b_mat).ok_or_else(|| {
-            cx.error(
+        Some(g_inv) => Some(
+            (closed_form(sym, low, g_inv, &b_mat))
+                .map_err(|o| reduced(o, cx, &w.span, "the projector P"))?
+                .ok_or_else(|| {
+                    cx.error(
                 ErrorKind::Structure(format!(
                     "wall `{}`: BG⁻¹Bᵀ is singular for generic parameters and configurations, so P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B does not exist",
                     w.name
@@ -82,7 +86,11 @@ fn wall(
         })?),
         None => None,
     };
-    let normal: Vec<Atom> = raw.normal.iter().map(|a| low.reduce(a)).collect();
+    let normal = (raw.normal.iter().map(|a| low.reduce(a)))
+        .collect::<Result<Vec<Atom>, _>>()
+        .map_err(|o| reduced(o, cx, &w.span, "the normal"))?;
+    let hessian =
+        (low.reduce(&raw.hessian)).map_err(|o| reduced(o, cx, &w.span, "the Hessian form"))?;
     let mut normal_velocity = Atom::num(0);
     for (k, row) in normal.iter().enumerate() {
         normal_velocity += row.clone() * sym.vel(k);
@@ -93,7 +101,7 @@ fn wall(
         (Quantity::Surface, vec![raw.surface.clone()], 0),
         (Quantity::Normal, normal, 0),
         (Quantity::NormalVelocity, vec![normal_velocity], 0),
-        (Quantity::SurfaceHessian, vec![low.reduce(&raw.hessian)], 0),
+        (Quantity::SurfaceHessian, vec![hessian], 0),
         (Quantity::WallRows, b_flat, b_atoms.len()),
     ] {
         functions.extend(
@@ -131,10 +139,10 @@ fn wall(
             }
             Projection::ClosedForm {
                 projector: strings(p),
-                collision: collide
-                    .iter()
+                collision: (collide.iter())
                     .map(|x| low.collect_velocities(sym, x))
-                    .collect(),
+                    .collect::<Result<_, _>>()
+                    .map_err(|o| reduced(o, cx, &w.span, "the collision map"))?,
             }
         }
         None => Projection::Structured,
@@ -205,7 +213,8 @@ fn rows(
         &b,
         &dropped.iter().map(|(r, _)| r.clone()).collect::<Vec<_>>(),
         n,
-    );
+    )
+    .map_err(|o| reduced(o, cx, &w.span, "the rows of B"))?;
     let dropped: Vec<String> = dropped.into_iter().map(|(_, o)| o).collect();
     checks::wall_hypotheses(cx, w, &b, &exact.a, &candidates[0].0, &exact.field);
     if kept.is_empty() {
@@ -241,17 +250,19 @@ fn rows(
 }
 
 /// P entry by entry and (I − 2P)v, simplified; `None` when BG⁻¹Bᵀ is
-/// singular.
+/// singular, [`Over`] where the simplification is past the budget.
 #[allow(clippy::type_complexity, clippy::needless_range_loop)]
 fn closed_form(
     sym: &Symbols,
     low: &Lowering,
     g_inv: &Matrix<Field>,
     b: &Matrix<Field>,
-) -> Option<(Vec<Vec<Atom>>, Vec<Atom>)> {
+) -> Result<Option<(Vec<Vec<Atom>>, Vec<Atom>)>, Over> {
     let n = sym.vels.len();
-    let p = projector(g_inv, b)?;
-    let p_atoms = simplified(low, &p, n, n);
+    let Some(p) = projector(g_inv, b) else {
+        return Ok(None);
+    };
+    let p_atoms = simplified(low, &p, n, n)?;
     let collide = (0..n)
         .map(|i| {
             let mut s = sym.vel(i);
@@ -261,7 +272,7 @@ fn closed_form(
             s
         })
         .collect();
-    Some((p_atoms, collide))
+    Ok(Some((p_atoms, collide)))
 }
 
 /// The collision map on admissible velocities (A v = 0, the only ones a
@@ -302,7 +313,8 @@ fn admissible_collision(
         let Ok(inv) = a_d.inv() else {
             continue;
         };
-        let t = simplified(low, &(&inv * &a_mat), k, n);
+        let t =
+            simplified(low, &(&inv * &a_mat), k, n).map_err(|o| reduced(o, cx, span, ON_KER_A))?;
         if !t.iter().flatten().any(|e| varies(c, e)) {
             through.push((d, t));
         }
@@ -321,7 +333,8 @@ fn admissible_collision(
                     })
                     .collect()
             })
-            .collect();
+            .collect::<Result<_, _>>()
+            .map_err(|o| reduced(o, cx, span, ON_KER_A))?;
         let rows: Vec<usize> = folded.iter().map(|r| row_cost(r)).collect();
         // Outputs E computed from the others (rows over v⁺), each where
         // that is cheaper; E = ∅ first.
@@ -375,8 +388,21 @@ fn row_cost(row: &[Atom]) -> usize {
     (terms - plus - minus) + terms.saturating_sub(1) + negation
 }
 
+/// What the admissible collision map's reductions name in their errors.
+const ON_KER_A: &str = "the collision map on admissible velocities";
+
+/// The error of a reduction past the budget in `what`, at the wall's `span`.
+fn reduced(o: Over, cx: &mut Collector, span: &std::ops::Range<usize>, what: &str) -> Reported {
+    o.report(cx, span, &lower::reduced(what))
+}
+
 /// The entries of a rows × cols matrix, simplified.
-fn simplified(low: &Lowering, m: &Matrix<Field>, rows: usize, cols: usize) -> Vec<Vec<Atom>> {
+fn simplified(
+    low: &Lowering,
+    m: &Matrix<Field>,
+    rows: usize,
+    cols: usize,
+) -> Result<Vec<Vec<Atom>>, Over> {
     (0..rows)
         .map(|i| {
             (0..cols)
@@ -522,22 +548,27 @@ fn independent_rows(
 /// great circle of the wall). P itself is the same rational function for
 /// any basis of the span, so the closed form stays right everywhere; what
 /// evaluates B's kept rows at run time does not.
-fn steady(c: &Context, kept: &[Vec<Rat>], dropped: &[Vec<Rat>], n: usize) -> bool {
+fn steady(c: &Context, kept: &[Vec<Rat>], dropped: &[Vec<Rat>], n: usize) -> Result<bool, Over> {
     if dropped.is_empty() {
-        return true;
+        return Ok(true);
     }
     let field = &c.exact.field;
     let Some(k) = rows_matrix(kept, n, field) else {
-        return false;
+        return Ok(false);
     };
     let Ok(inverse) = (&k * &k.transpose()).inv() else {
-        return false;
+        return Ok(false);
     };
-    dropped.iter().all(|d| {
+    for d in dropped {
         let Some(row) = rows_matrix(std::slice::from_ref(d), n, field) else {
-            return false;
+            return Ok(false);
         };
         let lambda = &(&row * &k.transpose()) * &inverse;
-        (0..kept.len()).all(|i| !varies(c, &c.low.simplify(&lambda[(0, i as u32)])))
-    })
+        for i in 0..kept.len() {
+            if varies(c, &c.low.simplify(&lambda[(0, i as u32)])?) {
+                return Ok(false);
+            }
+        }
+    }
+    Ok(true)
 }
