@@ -10,7 +10,7 @@ mod common;
 use dalembert::models::{BallBounce, Chain3, PendulumWall, Superball};
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
-    Integrator, ReturnError, Section, Settings, State, Taylor, return_map,
+    Integrator, ReturnError, Section, Settings, Simulator, State, Taylor, return_map,
 };
 use dalembert_periodic::{self as periodic, PeriodicError, Search, Stability};
 
@@ -239,6 +239,73 @@ fn superball_vertical_bounce_and_its_multipliers() {
         );
     }
     assert_eq!(found.len(), 5);
+}
+
+/// An angle that returns after a whole turn: the ball of
+/// models/ball_bounce.toml bouncing straight up and down at θ = π/2 while
+/// it spins about the vertical (φ̇ = ω, every other rate 0). The floor's
+/// contact rows do not see that spin, so each bounce only reverses ż, and
+/// φ advances by ω·2ż/g per flight. Declared an angle, φ returns when
+/// ω·2ż/g = 2π; from ω 2 % off that, Newton's method must reach such an
+/// orbit, with the period 2ż/g of the flight and one whole turn of φ.
+/// Run on from the orbit for one period, the simulator comes back to the
+/// same state, φ + 2π. (Taken as it is, φ would have to return to its own
+/// value, which needs ω = 0.)
+#[test]
+fn an_angle_returns_after_a_whole_turn() {
+    let m = BallBounce::default();
+    let g = m.params().g;
+    let (z_dot, flight) = (5.0, 2.0 * 5.0 / g);
+    let mut q = [0.0; 6];
+    q[2] = m.params().r;
+    q[4] = core::f64::consts::FRAC_PI_2;
+    let mut v = [0.0; 6];
+    v[2] = z_dot;
+    v[3] = 1.02 * core::f64::consts::TAU / flight;
+    let start = State { t: 0.0, q, v };
+    let section = Section {
+        wall: BallBounce::WALLS[0],
+        returns: 1,
+        t_max: 100.0,
+    };
+    let search = Search {
+        settings: dormand_prince(1e-12),
+        tolerance: 1e-12,
+        angles: periodic::Angles::of(&[3]).unwrap(),
+        ..Search::default()
+    };
+    let orbit = periodic::find(&m, start, &section, &search).unwrap();
+    let at = format!("{orbit:?}");
+    assert_eq!(orbit.turns, [0, 0, 0, 1, 0, 0], "{at}");
+    let (z_dot, omega) = (orbit.state.v[2], orbit.state.v[3]);
+    assert!(
+        (orbit.period - 2.0 * z_dot / g).abs() <= 1e-12 * orbit.period,
+        "{at}"
+    );
+    assert!(
+        (omega * orbit.period - core::f64::consts::TAU).abs() <= 1e-9,
+        "{at}"
+    );
+    let mut sim = Simulator::new(&m, orbit.state, dormand_prince(1e-12)).unwrap();
+    let end = loop {
+        let step = sim.step(f64::INFINITY).unwrap();
+        if step.collision.is_some() {
+            break step.state;
+        }
+    };
+    assert!((end.t - orbit.period).abs() <= 1e-12, "{end:?}, {at}");
+    let mut expected = orbit.state.q;
+    expected[3] += core::f64::consts::TAU;
+    for i in 0..6 {
+        assert!(
+            (end.q[i] - expected[i]).abs() <= 1e-8,
+            "q[{i}]: {end:?}, {at}"
+        );
+        assert!(
+            (end.v[i] - orbit.state.v[i]).abs() <= 1e-8,
+            "v[{i}]: {end:?}, {at}"
+        );
+    }
 }
 
 /// What the search cannot do is an error that says so: no return within

@@ -6,7 +6,7 @@ use clap::Args;
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::saltation::SaltationError;
 use dalembert::runtime::simulate::{ReturnError, Section, VariationalError};
-use dalembert_periodic::{self as periodic, Orbit, PeriodicError, Search, Stability};
+use dalembert_periodic::{self as periodic, Angles, Orbit, PeriodicError, Search, Stability};
 
 use crate::run::{RunArgs, WithModel, checked_run, positive, settings, start, with_model};
 
@@ -32,6 +32,11 @@ pub struct PeriodicArgs {
     /// The longest one return map may run, in model time.
     #[arg(long, allow_hyphen_values = true, default_value_t = 100.0)]
     pub t_max: f64,
+    /// Coordinates that are angles: they return modulo 2π, so an orbit
+    /// along which one makes whole turns is periodic (comma-separated
+    /// names).
+    #[arg(long, value_name = "NAME,…", value_delimiter = ',')]
+    pub angles: Vec<String>,
     /// Write the orbit as JSON: {"period", "state", "multipliers": [[re,
     /// im], …], "residual", "iterations", …}.
     #[arg(long)]
@@ -94,6 +99,7 @@ impl WithModel for Periodic<'_> {
             rtol: args.run.rtol,
             tolerance: args.residual,
             max_iterations: args.iterations,
+            angles: angles(&model, &args.angles)?,
             ..Search::default()
         };
         let orbit = match periodic::find(&model, start, &section, &search) {
@@ -111,6 +117,28 @@ impl WithModel for Periodic<'_> {
         }
         Ok(true)
     }
+}
+
+/// The coordinates `names` as a set of angles.
+fn angles<M: Surfaces<N>, const N: usize>(model: &M, names: &[String]) -> Result<Angles, String> {
+    let coordinates = model.coordinate_names();
+    let indices = names
+        .iter()
+        .map(|name| {
+            coordinates
+                .iter()
+                .position(|c| *c == name.as_str())
+                .ok_or_else(|| {
+                    format!(
+                        "--angles: `{name}` is not a coordinate of {} ({})",
+                        model.name(),
+                        coordinates.join(", ")
+                    )
+                })
+        })
+        .collect::<Result<Vec<usize>, String>>()?;
+    Angles::of(&indices)
+        .ok_or_else(|| "--angles: only the first 64 coordinates can be angles".to_string())
 }
 
 /// Why no orbit was found, naming walls as the model file does.
@@ -218,6 +246,11 @@ fn report<M: Surfaces<N>, const N: usize>(
         "  found in {} Newton steps, residual |Π(x₀) − x₀|∞/max(1, |x₀|∞) = {:.3e}",
         orbit.iterations, orbit.residual
     );
+    for (name, turns) in model.coordinate_names().iter().zip(&orbit.turns) {
+        if *turns != 0 {
+            println!("  {name} makes {turns} whole turn(s) per period (an angle, modulo 2π)");
+        }
+    }
     println!("  state on the section (just after the collision):");
     for (name, x) in model.coordinate_names().iter().zip(&orbit.state.q) {
         println!("    {name} = {x:.15}");
@@ -274,19 +307,25 @@ fn json<M: Surfaces<N>, const N: usize>(
         .iter()
         .map(|m| format!("[{}, {}]", number(m[0]), number(m[1])))
         .collect();
+    let turns: Vec<String> = (model.coordinate_names().iter())
+        .zip(&orbit.turns)
+        .filter(|(_, k)| **k != 0)
+        .map(|(n, k)| format!("\"{n}\": {k}"))
+        .collect();
     let stability = match periodic::stability(&orbit.multipliers, search.unit) {
         Stability::Unstable { .. } => "unstable",
         Stability::Neutral => "neutral",
         Stability::Stable { .. } => "stable",
     };
     format!(
-        "{{\"model\": \"{}\", \"wall\": \"{}\", \"returns\": {}, \"collisions\": {}, \"period\": {}, \"state\": {{{}}}, \"multipliers\": [{}], \"at_one\": {}, \"stability\": \"{stability}\", \"residual\": {}, \"iterations\": {}}}",
+        "{{\"model\": \"{}\", \"wall\": \"{}\", \"returns\": {}, \"collisions\": {}, \"period\": {}, \"state\": {{{}}}, \"turns\": {{{}}}, \"multipliers\": [{}], \"at_one\": {}, \"stability\": \"{stability}\", \"residual\": {}, \"iterations\": {}}}",
         model.name(),
         model.wall_name(section.wall),
         section.returns,
         orbit.collisions,
         number(orbit.period),
         state.join(", "),
+        turns.join(", "),
         multipliers.join(", "),
         at_one(orbit, search.unit),
         number(orbit.residual),

@@ -132,6 +132,30 @@ fn the_superball_as_a_model_file() {
     );
 }
 
+/// ball_bounce spinning about the vertical while it bounces straight up
+/// (tests/periodic.rs has the same orbit through the library): with
+/// `--angles phi` the orbit's φ makes one whole turn per flight, and the
+/// JSON says so; without, no orbit turns.
+#[test]
+fn an_angle_that_makes_a_whole_turn() {
+    let omega = 1.02 * std::f64::consts::TAU / (2.0 * 5.0 / 9.81);
+    let spin = format!("phi_dot={omega}");
+    let mut args = vec!["periodic", "ball_bounce", "--rtol", "1e-12", "--json"];
+    for set in ["x_dot=0", "psi_dot=0", "z_dot=5", &spin] {
+        args.extend(["--set", set]);
+    }
+    let (code, stdout, stderr) = run(&[&args[..], &["--angles", "phi"]].concat());
+    assert_eq!(code, Some(0), "{stderr}");
+    let json = stdout.trim();
+    assert!(json.contains("\"turns\": {\"phi\": 1}"), "{json}");
+    let turn = field(json, "phi_dot") * field(json, "period");
+    assert!((turn - std::f64::consts::TAU).abs() <= 1e-8, "{json}");
+    // Without --angles φ must come back to its own value: no orbit that
+    // turns (here Newton's method heads for ω = 0 and runs out of steps).
+    let (_, stdout, stderr) = run(&args);
+    assert!(!stdout.contains("\"phi\": 1"), "{stdout}{stderr}");
+}
+
 #[test]
 fn mistakes_in_the_arguments() {
     for (args, says) in [
@@ -148,6 +172,10 @@ fn mistakes_in_the_arguments() {
             "--t-max must be a positive finite number",
         ),
         (&["periodic", "ball_floor"][..], "instantaneous model"),
+        (
+            &["periodic", "superball", "--angles", "a,phi"][..],
+            "--angles: `phi` is not a coordinate of superball (x, z, a)",
+        ),
     ] {
         let (code, _, stderr) = run(args);
         assert_eq!(code, Some(2), "{args:?}: {stderr}");

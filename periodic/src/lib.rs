@@ -6,6 +6,9 @@
 //! An orbit is sought as a fixed point of a wall's return map Π
 //! ([`return_map`]): a state x₀ just after a collision with the wall from
 //! which the motion comes back to x₀ at its `returns`-th collision with it.
+//! Coordinates declared angles ([`Search::angles`]) return modulo 2π: there
+//! Π(x₀) − x₀ is taken to the nearest whole turn, so an orbit along which
+//! an angle makes full turns is periodic ([`Orbit::turns`] counts them).
 //! Newton's method solves Π(x₀) = x₀ over the states x₀ + Zξ, Z an
 //! orthonormal basis of the perturbations along the section that the
 //! constraints allow (tangent to h(q) = 0, A(q)q̇ = 0 and f(q) = 0): each
@@ -58,6 +61,48 @@ pub struct Search {
     /// it (and within it of 1, as 1). Multipliers of a Jordan block are
     /// only as accurate as the square root of DΠ's error.
     pub unit: f64,
+    /// The coordinates that are angles, which return modulo 2π (none by
+    /// default: every coordinate must come back to its own value).
+    pub angles: Angles,
+}
+
+/// A set of coordinates (by index, each below 64) that are angles: a
+/// return that differs from the start by whole turns, 2πk, in them is a
+/// return.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Angles(u64);
+
+impl Angles {
+    /// No angles.
+    pub const NONE: Self = Self(0);
+
+    /// The coordinates `indices`; `None` if one is 64 or more.
+    pub fn of(indices: &[usize]) -> Option<Self> {
+        indices
+            .iter()
+            .try_fold(0_u64, |set, &k| {
+                Some(set | 1_u64.checked_shl(u32::try_from(k).ok()?)?)
+            })
+            .map(Self)
+    }
+
+    /// Whether coordinate `k` is an angle.
+    pub fn contains(self, k: usize) -> bool {
+        u32::try_from(k)
+            .ok()
+            .and_then(|k| self.0.checked_shr(k))
+            .is_some_and(|bits| bits & 1 == 1)
+    }
+
+    /// The whole turns in a change `d` of coordinate `k`: the nearest
+    /// integer to d/2π for an angle, 0 otherwise.
+    fn turns(self, k: usize, d: f64) -> f64 {
+        if self.contains(k) {
+            (d / core::f64::consts::TAU).round()
+        } else {
+            0.0
+        }
+    }
 }
 
 impl Default for Search {
@@ -70,6 +115,7 @@ impl Default for Search {
             halvings: 12,
             cutoff: 1e-6,
             unit: 1e-5,
+            angles: Angles::NONE,
         }
     }
 }
@@ -91,6 +137,9 @@ pub struct Orbit<const N: usize> {
     pub iterations: usize,
     /// Collisions in one period, with every wall.
     pub collisions: u64,
+    /// The whole turns each coordinate makes in one period: Π(x₀) = x₀ +
+    /// 2π·turns in q (zero but for [`Search::angles`]).
+    pub turns: [i64; N],
 }
 
 /// What the multipliers say about an orbit's linear stability.
@@ -198,9 +247,10 @@ pub fn find<M: Surfaces<N>, const N: usize>(
 ) -> Result<Orbit<N>, PeriodicError<M::Wall>> {
     let mut x = onto_section(model, start, section, search.settings)?;
     x.t = 0.0;
+    let angles = search.angles;
     let residual_of = |x: &State<N>, r: &Return<N>| {
         let scale = norm_inf(&x.q).max(norm_inf(&x.v)).max(1.0);
-        let d = difference(&r.state, x);
+        let d = difference(&r.state, x, angles);
         d.iter().fold(0.0_f64, |m, e| m.max(e.abs())) / scale
     };
     let mut iterations = 0;
@@ -219,6 +269,9 @@ pub fn find<M: Surfaces<N>, const N: usize>(
                 residual,
                 iterations,
                 collisions: map.collisions,
+                // (Whole numbers, far below 2⁶³.)
+                #[allow(clippy::cast_possible_truncation)]
+                turns: core::array::from_fn(|k| angles.turns(k, map.state.q[k] - x.q[k]) as i64),
             });
         }
         if iterations == search.max_iterations {
@@ -231,7 +284,7 @@ pub fn find<M: Surfaces<N>, const N: usize>(
         let z = section_basis(model, &x, section.wall)?;
         let dpi = dense(&jacobian);
         let a = (&dpi - DMatrix::identity(2 * N, 2 * N)) * &z;
-        let r = DVector::from_vec(difference(&map.state, &x).to_vec());
+        let r = DVector::from_vec(difference(&map.state, &x, angles));
         let svd = nalgebra::linalg::SVD::try_new(a, true, true, 5.0 * f64::EPSILON, 100_000)
             .ok_or(PeriodicError::Decomposition)?;
         let largest = svd.singular_values.max();
@@ -285,9 +338,12 @@ pub fn stability(multipliers: &[[f64; 2]], unit: f64) -> Stability {
     }
 }
 
-/// Π(x) − x over (q, q̇).
-fn difference<const N: usize>(y: &State<N>, x: &State<N>) -> Vec<f64> {
-    let dq = y.q.iter().zip(&x.q).map(|(a, b)| a - b);
+/// Π(x) − x over (q, q̇), less the whole turns of the angles.
+fn difference<const N: usize>(y: &State<N>, x: &State<N>, angles: Angles) -> Vec<f64> {
+    let dq = (y.q.iter().zip(&x.q).enumerate()).map(|(k, (a, b))| {
+        let d = a - b;
+        d - core::f64::consts::TAU * angles.turns(k, d)
+    });
     let dv = y.v.iter().zip(&x.v).map(|(a, b)| a - b);
     dq.chain(dv).collect()
 }
@@ -437,7 +493,21 @@ fn norm_inf<const N: usize>(x: &[f64; N]) -> f64 {
 
 #[cfg(test)]
 mod tests {
-    use super::{Stability, stability};
+    use super::{Angles, Stability, stability};
+
+    #[test]
+    fn angles_count_whole_turns() {
+        let a = Angles::of(&[0, 2, 63]).unwrap();
+        assert!(a.contains(0) && a.contains(2) && a.contains(63));
+        assert!(!a.contains(1) && !a.contains(64) && !a.contains(usize::MAX));
+        assert_eq!(Angles::of(&[64]), None);
+        assert_eq!(Angles::of(&[]), Some(Angles::NONE));
+        let tau = core::f64::consts::TAU;
+        assert_eq!(a.turns(0, 3.0 * tau - 0.1), 3.0);
+        assert_eq!(a.turns(2, -tau + 3.0), -1.0);
+        assert_eq!(a.turns(2, 3.0), 0.0);
+        assert_eq!(a.turns(1, 3.0 * tau), 0.0, "not an angle");
+    }
 
     #[test]
     fn the_verdict_reads_the_moduli() {
