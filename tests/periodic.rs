@@ -7,7 +7,7 @@
 
 mod common;
 
-use dalembert::models::{BallBounce, Chain3, PendulumWall, Superball};
+use dalembert::models::{BallBounce, Chain3, PendulumWall, Puck, Superball};
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
     Integrator, ReturnError, Section, Settings, Simulator, State, Taylor, return_map,
@@ -306,6 +306,31 @@ fn an_angle_returns_after_a_whole_turn() {
             "v[{i}]: {end:?}, {at}"
         );
     }
+}
+
+/// A search that heads for motions along the wall says so: from the puck's
+/// own start every full Newton step lands where the puck no longer leaves
+/// the wall (its normal velocity 0), only halves of it are taken, and the
+/// residual halves each step. Stopped by the step limit, the error is
+/// `TowardsGrazing` with a normal velocity at rounding level, not
+/// `NoConvergence` (which invites more steps).
+#[test]
+fn a_search_that_heads_for_grazing_says_so() {
+    let m = Puck::default();
+    let section = Section {
+        wall: Puck::WALLS[0],
+        returns: 1,
+        t_max: 100.0,
+    };
+    let e = periodic::find(&m, initial(&m), &section, &Search::default()).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            PeriodicError::TowardsGrazing { iterations: 20, residual, normal_velocity }
+                if residual < 1e-4 && normal_velocity.abs() < 1e-9
+        ),
+        "{e:?}"
+    );
 }
 
 /// What the search cannot do is an error that says so: no return within

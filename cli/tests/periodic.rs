@@ -156,6 +156,19 @@ fn an_angle_that_makes_a_whole_turn() {
     assert!(!stdout.contains("\"phi\": 1"), "{stdout}{stderr}");
 }
 
+/// The puck's search heads for motions along its wall (tests/periodic.rs):
+/// the reason says so and that more steps will not help.
+#[test]
+fn a_search_towards_grazing_is_named() {
+    let (code, _, stderr) = run(&["periodic", "puck"]);
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains("heads for motions that slide along `wall`")
+            && stderr.contains("more --iterations will not help"),
+        "{stderr}"
+    );
+}
+
 #[test]
 fn mistakes_in_the_arguments() {
     for (args, says) in [

@@ -183,6 +183,22 @@ pub enum PeriodicError<W> {
         /// The residual it stalled at.
         residual: f64,
     },
+    /// Newton's method stopped (as [`PeriodicError::NoConvergence`] or
+    /// [`PeriodicError::Stalled`] would say) while heading for a state
+    /// that does not leave the wall: its last full step landed where the
+    /// normal velocity is not positive, so it could only be taken in part,
+    /// and the normal velocity of the state reached is below
+    /// [`GRAZING`] of the velocity's size. The states it approaches move
+    /// along the wall, not through collisions with it; more steps do not
+    /// help.
+    TowardsGrazing {
+        /// Steps taken.
+        iterations: usize,
+        /// The residual reached.
+        residual: f64,
+        /// The normal velocity df·q̇ at the last state.
+        normal_velocity: f64,
+    },
     /// (DΠ − I)Z is zero or not finite: Newton's method has no direction.
     SingularJacobian {
         /// Steps taken.
@@ -254,6 +270,28 @@ pub fn find<M: Surfaces<N>, const N: usize>(
         d.iter().fold(0.0_f64, |m, e| m.max(e.abs())) / scale
     };
     let mut iterations = 0;
+    // Whether the last full Newton step landed where the motion does not
+    // leave the wall.
+    let mut full_step_grazes = false;
+    let stopped = |x: &State<N>, full_step_grazes: bool, iterations, residual, stalled: bool| {
+        if full_step_grazes && nearly_grazes(model, x, section.wall) {
+            PeriodicError::TowardsGrazing {
+                iterations,
+                residual,
+                normal_velocity: model.normal_velocity(section.wall, &x.q, &x.v),
+            }
+        } else if stalled {
+            PeriodicError::Stalled {
+                iterations,
+                residual,
+            }
+        } else {
+            PeriodicError::NoConvergence {
+                iterations,
+                residual,
+            }
+        }
+    };
     loop {
         let map = return_map(model, x, section, search.settings, Some(search.rtol))?;
         let residual = residual_of(&x, &map);
@@ -275,10 +313,7 @@ pub fn find<M: Surfaces<N>, const N: usize>(
             });
         }
         if iterations == search.max_iterations {
-            return Err(PeriodicError::NoConvergence {
-                iterations,
-                residual,
-            });
+            return Err(stopped(&x, full_step_grazes, iterations, residual, false));
         }
         iterations += 1;
         let z = section_basis(model, &x, section.wall)?;
@@ -303,7 +338,13 @@ pub fn find<M: Surfaces<N>, const N: usize>(
         // return map fails, is rejected like one that does not lower the
         // residual.
         for _ in 0..=search.halvings {
-            if let Ok(trial) = restore(model, &x, &dx, lambda, section.wall)
+            let trial = restore(model, &x, &dx, lambda, section.wall);
+            if lambda == 1.0 {
+                full_step_grazes = trial
+                    .as_ref()
+                    .is_ok_and(|t| !leaves(model, t, section.wall));
+            }
+            if let Ok(trial) = trial
                 && let Ok(map) = return_map(model, trial, section, search.settings, None)
                 && residual_of(&trial, &map) < residual
             {
@@ -312,11 +353,29 @@ pub fn find<M: Surfaces<N>, const N: usize>(
             }
             lambda *= 0.5;
         }
-        x = accepted.ok_or(PeriodicError::Stalled {
-            iterations,
-            residual,
-        })?;
+        x = accepted.ok_or_else(|| stopped(&x, full_step_grazes, iterations, residual, true))?;
     }
+}
+
+/// Below this fraction of |df|·max(1, |q̇|∞), a normal velocity counts as
+/// a motion that nearly slides along the wall
+/// ([`PeriodicError::TowardsGrazing`]).
+pub const GRAZING: f64 = 1e-3;
+
+/// |df|·max(1, |q̇|∞) at `x`: the scale of its normal velocity.
+fn normal_scale<M: Surfaces<N>, const N: usize>(model: &M, x: &State<N>, wall: M::Wall) -> f64 {
+    norm(&model.normal(wall, &x.q)) * norm_inf(&x.v).max(1.0)
+}
+
+/// Whether the motion from `x` (on the wall) leaves it: a normal velocity
+/// above rounding of its scale.
+fn leaves<M: Surfaces<N>, const N: usize>(model: &M, x: &State<N>, wall: M::Wall) -> bool {
+    model.normal_velocity(wall, &x.q, &x.v) > 1e-9 * normal_scale(model, x, wall)
+}
+
+/// Whether `x`'s normal velocity is below [`GRAZING`] of its scale.
+fn nearly_grazes<M: Surfaces<N>, const N: usize>(model: &M, x: &State<N>, wall: M::Wall) -> bool {
+    model.normal_velocity(wall, &x.q, &x.v).abs() <= GRAZING * normal_scale(model, x, wall)
 }
 
 /// The linear stability the multipliers give, with `unit` the distance
