@@ -58,6 +58,44 @@ fn bodies_give_the_hand_written_models() {
     }
 }
 
+/// Springs: a rod whose tip (a point fixed in the body, turned by its
+/// angle) is joined to a fixed point by a spring of rest length L, its
+/// centre to the origin by one of length 0, derives exactly what the same
+/// potential written by hand does.
+#[test]
+fn springs_give_the_hand_written_potential() {
+    same_model(
+        "rod_spring",
+        &derived("tests/bodies/springs", "rod_spring"),
+        &derived("tests/bodies/springs", "rod_spring_by_hand"),
+    );
+}
+
+/// A bob on a spring (k, rest length L) from a fixed point H above the
+/// floor, in gravity: released at rest 0.3 below its equilibrium
+/// z* = H − L − m g/k, it oscillates as z* − 0.3 cos(√(k/m) t) (the spring
+/// stays stretched, so |P₁ − P₂| is H − z).
+#[test]
+fn a_bob_on_a_spring_oscillates_as_theory_says() {
+    let d = derived("tests/bodies/springs", "bob");
+    let m = Interpreted::<3>::new(&d).unwrap();
+    let (mass, k, rest, anchor, g) = (2.0, 50.0, 1.0, 3.0, 9.81);
+    let z_eq: f64 = anchor - rest - mass * g / k;
+    let omega = (k / mass).sqrt();
+    let start = State {
+        t: 0.0,
+        q: [0.0, 0.0, z_eq - 0.3],
+        v: [0.0; 3],
+    };
+    let mut sim = Simulator::new(&m, start, common::dormand_prince(1e-13)).unwrap();
+    for t in [0.1, 0.7, 1.3, 2.0] {
+        sim.run(t, |_| true).unwrap();
+        let z = sim.state().q[2];
+        let expected = z_eq - 0.3 * (omega * t).cos();
+        assert!((z - expected).abs() < 1e-9, "t = {t}: z = {z}, {expected}");
+    }
+}
+
 /// The tutorial's two puck files (docs/tutorial.md, step 1: as bodies,
 /// then by hand) derive the built-in puck.
 #[test]

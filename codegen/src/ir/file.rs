@@ -23,6 +23,8 @@ pub(super) struct File {
     #[serde(default)]
     pub(super) knife_edge: Vec<Spanned<KnifeEdgeDecl>>,
     #[serde(default)]
+    pub(super) spring: Vec<Spanned<SpringDecl>>,
+    #[serde(default)]
     pub(super) wall: Vec<Spanned<WallDecl>>,
     #[serde(default)]
     pub(super) initial: IndexMap<Spanned<String>, Spanned<Number>>,
@@ -168,6 +170,28 @@ pub(super) struct RollingDecl {
     pub(super) plane: Option<Spanned<PlaneDecl>>,
     pub(super) sphere: Option<Spanned<RoundDecl>>,
     pub(super) cylinder: Option<Spanned<RoundDecl>>,
+}
+
+/// A linear spring between two points: V = ½ k (|P₁ − P₂| − L)².
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct SpringDecl {
+    /// k > 0.
+    pub(super) stiffness: Spanned<Number>,
+    /// The rest length L ≥ 0 (0 if absent).
+    pub(super) length: Option<Spanned<Number>>,
+    /// The two ends.
+    pub(super) ends: Spanned<Vec<Spanned<EndDecl>>>,
+}
+
+/// A spring's end: a point of a body (its centre, or `at` in the body
+/// frame from the centre) or a point fixed in space.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct EndDecl {
+    pub(super) body: Option<Spanned<String>>,
+    pub(super) at: Option<Spanned<Vec<Spanned<Number>>>>,
+    pub(super) point: Option<Spanned<Vec<Spanned<Number>>>>,
 }
 
 /// A knife edge (skate) at the body's centre, its blade along a body-frame

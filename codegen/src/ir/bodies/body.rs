@@ -188,7 +188,7 @@ impl Layer<'_> {
 
     /// Records an error when a quantity that must be positive is not, at the
     /// file's parameter values (and goes on).
-    fn positive(&mut self, s: &Sym, what: &str, span: Range<usize>) {
+    pub(super) fn positive(&mut self, s: &Sym, what: &str, span: Range<usize>) {
         if let Some(v) = self.value(s)
             && v.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
         {

@@ -21,7 +21,7 @@ enum Shape {
 
 impl Layer<'_> {
     /// The body a constraint or wall names.
-    fn find(&mut self, body: &Spanned<String>) -> Option<Body> {
+    pub(super) fn find(&mut self, body: &Spanned<String>) -> Option<Body> {
         if !self.bodies.contains_key(body.get_ref()) {
             // A body declared but not read has had its errors reported.
             if self.declared_bodies.contains(body.get_ref()) {

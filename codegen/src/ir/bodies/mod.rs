@@ -17,7 +17,8 @@
 //!   norm is a holonomic constraint and 2 tr(I)/3 (e · ė)² is added to T: it
 //!   vanishes to second order on |e| = 1 and makes G positive definite (for
 //!   a ball the sum is 2 J |ė|² on |e| = 1, which is what is written);
-//! - V = −Σ m g · S for uniform gravity g;
+//! - V = −Σ m g · S for uniform gravity g, and ½ k (|P₁ − P₂| − L)² for a
+//!   spring between two points, each of a body or fixed (`spring.rs`);
 //! - a ball rolling on a plane: its contact point C = S − r n at rest, as
 //!   the two rows Ċ · eᵢ across the normal's largest component, and the
 //!   height n · S − offset − r = 0 as a holonomic constraint where it varies;
@@ -32,6 +33,7 @@
 mod body;
 mod contact;
 mod frames;
+mod spring;
 mod sym;
 
 use std::collections::{HashMap, HashSet};
@@ -105,6 +107,9 @@ pub(super) fn expand(file: &mut File, cx: &mut Collector) -> Vec<FromBodies> {
     }
     for decl in &file.knife_edge {
         layer.knife_edge(decl);
+    }
+    for decl in &file.spring {
+        layer.spring(decl);
     }
     for decl in &mut file.wall {
         let span = decl.span();
@@ -350,6 +355,7 @@ impl Layer<'_> {
 fn refuse_without_bodies(file: &File, cx: &mut Collector) {
     let mut spans: Vec<Range<usize>> = file.rolling.iter().map(|r| r.span()).collect();
     spans.extend(file.knife_edge.iter().map(|k| k.span()));
+    spans.extend(file.spring.iter().map(|k| k.span()));
     spans.extend(file.fields.iter().map(|f| f.span()));
     spans.extend(
         file.wall
