@@ -250,7 +250,7 @@ fn superball_vertical_bounce_and_its_multipliers() {
 /// orbit, with the period 2ż/g of the flight and one whole turn of φ.
 /// Run on from the orbit for one period, the simulator comes back to the
 /// same state, φ + 2π. (Taken as it is, φ would have to return to its own
-/// value, which needs ω = 0.)
+/// value, which needs ω = 0 or no flight.)
 #[test]
 fn an_angle_returns_after_a_whole_turn() {
     let m = BallBounce::default();
