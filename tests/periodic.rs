@@ -296,15 +296,10 @@ fn an_angle_returns_after_a_whole_turn() {
     assert!((end.t - orbit.period).abs() <= 1e-12, "{end:?}, {at}");
     let mut expected = orbit.state.q;
     expected[3] += core::f64::consts::TAU;
-    for i in 0..6 {
-        assert!(
-            (end.q[i] - expected[i]).abs() <= 1e-8,
-            "q[{i}]: {end:?}, {at}"
-        );
-        assert!(
-            (end.v[i] - orbit.state.v[i]).abs() <= 1e-8,
-            "v[{i}]: {end:?}, {at}"
-        );
+    let got = end.q.iter().chain(&end.v);
+    let want = expected.iter().chain(&orbit.state.v);
+    for (i, (g, w)) in got.zip(want).enumerate() {
+        assert!((g - w).abs() <= 1e-8, "entry {i} of (q, v): {end:?}, {at}");
     }
 }
 
