@@ -58,6 +58,111 @@ fn bodies_give_the_hand_written_models() {
     }
 }
 
+/// A coin rolling on the floor (`disk` as its contact shape): its rolling
+/// rows, found from the rim's point nearest the floor with no root (the
+/// centre's height R sin θ stands for R|n − (n·e)e|), derive exactly what
+/// the rows written by hand through the body's y axis do. Their rate Ȧq̇
+/// is evaluated as written, with the division by the height that the
+/// exact passes cancel, so it alone costs more than by hand.
+#[test]
+fn a_rolling_coin_gives_the_hand_written_model() {
+    let (b, h) = (
+        derived("tests/bodies", "coin"),
+        derived("tests/bodies", "coin_by_hand"),
+    );
+    same_quantities("coin", &b, &h);
+    same_cost("coin", &b, &h, &["constraint_drift"]);
+}
+
+/// The coin (tests/bodies/coin.toml) against closed forms: upright with
+/// spin ψ̇ = w and no turning it rolls straight, x = −R w t, staying
+/// upright; upright turning about its vertical diameter (φ̇ = Ω, ψ̇ = 0)
+/// its centre stays put. From a tilted, turning start, along the run the
+/// energy is kept and the rim's point nearest the floor, computed here as
+/// C = S − R u with u = R_z(φ) R_x(θ) e_y, is at rest.
+#[test]
+fn a_rolling_coin_moves_as_theory_says() {
+    let d = derived("tests/bodies", "coin");
+    let m = Interpreted::<5>::new(&d).unwrap();
+    let r = 0.5;
+    let settings = common::dormand_prince(1e-12);
+    let given = [false, false, true, true, true];
+    let start = |theta: f64, rates: [f64; 3]| {
+        let q = [0.0, 0.0, 0.3, theta, 0.0];
+        let v = [0.0, 0.0, rates[0], rates[1], rates[2]];
+        let (v, _) = dalembert::runtime::simulate::starting_velocity(&m, &q, &v, &given).unwrap();
+        State { t: 0.0, q, v }
+    };
+    let upright = std::f64::consts::FRAC_PI_2;
+
+    // Rolling straight along the heading φ = 0.3.
+    let w = 3.0;
+    let mut sim = Simulator::new(&m, start(upright, [0.0, 0.0, w]), settings).unwrap();
+    sim.run(1.0, |_| true).unwrap();
+    let x = sim.state();
+    let along = [0.3f64.cos(), 0.3f64.sin()];
+    for (i, a) in along.iter().enumerate() {
+        assert!((x.q[i] + r * w * a).abs() < 1e-10, "straight: {x:?}");
+    }
+    assert!((x.q[3] - upright).abs() < 1e-10, "straight: {x:?}");
+
+    // Turning about the vertical diameter.
+    let mut sim = Simulator::new(&m, start(upright, [2.0, 0.0, 0.0]), settings).unwrap();
+    sim.run(1.0, |_| true).unwrap();
+    let x = sim.state();
+    assert!(x.q[0].abs() < 1e-10 && x.q[1].abs() < 1e-10, "pivot: {x:?}");
+    assert!((x.q[2] - 2.3).abs() < 1e-10, "pivot: {x:?}");
+
+    // Tilted and turning: energy and no slip.
+    let energy = |q: &[f64; 5], v: &[f64; 5]| m.kinetic_energy(q, v) + m.potential(q);
+    let slip = |q: &[f64; 5], v: &[f64; 5]| {
+        let (phi, theta) = (q[2], q[3]);
+        let (dphi, dtheta, dpsi) = (v[2], v[3], v[4]);
+        let w = [
+            dtheta * phi.cos() + dpsi * phi.sin() * theta.sin(),
+            dtheta * phi.sin() - dpsi * phi.cos() * theta.sin(),
+            dphi + dpsi * theta.cos(),
+        ];
+        let u = [
+            -phi.sin() * theta.cos(),
+            phi.cos() * theta.cos(),
+            theta.sin(),
+        ];
+        let centre = [v[0], v[1], r * theta.cos() * dtheta];
+        let turn = [
+            w[1] * u[2] - w[2] * u[1],
+            w[2] * u[0] - w[0] * u[2],
+            w[0] * u[1] - w[1] * u[0],
+        ];
+        (0..3)
+            .map(|i| (centre[i] - r * turn[i]).abs())
+            .fold(0.0, f64::max)
+    };
+    let x0 = start(1.2, [1.5, 0.0, 6.0]);
+    let e0 = energy(&x0.q, &x0.v);
+    assert!(slip(&x0.q, &x0.v) < 1e-12, "start: {x0:?}");
+    let mut sim = Simulator::new(&m, x0, settings).unwrap();
+    let mut worst = (0.0f64, 0.0f64);
+    sim.run(2.0, |step| {
+        let (q, v) = (&step.state.q, &step.state.v);
+        worst.0 = worst.0.max((energy(q, v) - e0).abs() / e0);
+        worst.1 = worst.1.max(slip(q, v));
+        true
+    })
+    .unwrap();
+    assert!(
+        sim.state().q[3] > 0.2,
+        "the coin fell flat: {:?}",
+        sim.state()
+    );
+    assert!(
+        worst.0 < 1e-9 && worst.1 < 1e-9,
+        "energy {:e}, slip {:e}",
+        worst.0,
+        worst.1
+    );
+}
+
 /// Springs: a rod whose tip (a point fixed in the body, turned by its
 /// angle) is joined to a fixed point by a spring of rest length L, its
 /// centre to the origin by one of length 0, derives exactly what the same
@@ -129,6 +234,12 @@ fn the_tutorial_files_give_the_puck() {
 /// `b` derives what `h` does: the same G, A, h(q), q̈, surfaces, P and
 /// collision maps (symbolic equality), and no more operations (5 %).
 fn same_model(name: &str, b: &Derivation, h: &Derivation) {
+    same_quantities(name, b, h);
+    same_cost(name, b, h, &[]);
+}
+
+/// The symbolic half of [`same_model`].
+fn same_quantities(name: &str, b: &Derivation, h: &Derivation) {
     assert_eq!(b.model.coordinates, h.model.coordinates, "{name}");
     assert_eq!(b.model.velocities, h.model.velocities, "{name}");
     for (i, (rb, rh)) in b.mass_matrix.iter().zip(&h.mass_matrix).enumerate() {
@@ -178,14 +289,22 @@ fn same_model(name: &str, b: &Derivation, h: &Derivation) {
             _ => panic!("{what}: P closed form for one and not the other"),
         }
     }
-    // The generated code costs what the hand-written model's does.
+}
+
+/// The cost half of [`same_model`]: every function but those `spared`
+/// takes at most 5 % more operations from `b` than from `h`.
+fn same_cost(name: &str, b: &Derivation, h: &Derivation, spared: &[&str]) {
     let (fb, fh) = (b.named_functions(), h.named_functions());
     assert_eq!(
         fb.iter().map(|(n, _)| n).collect::<Vec<_>>(),
         fh.iter().map(|(n, _)| n).collect::<Vec<_>>(),
         "{name}: functions"
     );
-    for ((n, b), (_, h)) in fb.iter().zip(&fh) {
+    for ((n, b), (_, h)) in fb
+        .iter()
+        .zip(&fh)
+        .filter(|((n, _), _)| !spared.contains(&n.as_str()))
+    {
         let (ob, oh) = (b.program.op_count().total(), h.program.op_count().total());
         assert!(
             ob as f64 <= 1.05 * oh as f64,

@@ -113,6 +113,16 @@ pub(super) struct BodyDecl {
     /// The contact shape: a sphere of this radius about the centre (absent:
     /// the centre is a point that meets walls).
     pub(super) radius: Option<Spanned<Number>>,
+    /// Or a disk (a coin's rim) about the centre.
+    pub(super) disk: Option<Spanned<DiskDecl>>,
+}
+
+/// A disk's rim: its radius and its axis in the body frame (a unit vector).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct DiskDecl {
+    pub(super) radius: Spanned<Number>,
+    pub(super) axis: Spanned<Vec<Spanned<Number>>>,
 }
 
 #[derive(Debug, Deserialize)]

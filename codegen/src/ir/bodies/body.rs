@@ -85,6 +85,32 @@ impl Layer<'_> {
             }
             None => None,
         };
+        let attitude_rotation = attitude.rotation();
+        let disk = match &b.disk {
+            Some(d) => {
+                if b.radius.is_some() {
+                    self.cx.error(
+                        structure(
+                            "a body's contact shape is a sphere (`radius`) or a `disk`, not both",
+                        ),
+                        Some(d.span()),
+                    );
+                    return;
+                }
+                let (Some(r), Some(axis)) = (
+                    self.sym(&d.get_ref().radius),
+                    self.vector(&d.get_ref().axis),
+                ) else {
+                    return;
+                };
+                self.positive(&r, "the disk's radius", d.get_ref().radius.span());
+                if self.unit_vector(&axis, d.get_ref().axis.span()).is_none() {
+                    return;
+                }
+                Some((r, frames::apply(&attitude_rotation, &axis)))
+            }
+            None => None,
+        };
 
         // Kinematics, with compound components as definitions.
         let velocity_raw: Vec3 = std::array::from_fn(|i| self.rate(&position[i]));
@@ -129,6 +155,15 @@ impl Layer<'_> {
                 j.clone(),
                 add(omega.iter().map(|w| square(w.clone()))),
             ])),
+            // Equal moments about the two axes other than the last angle's:
+            // the same T in the frame before the last rotation.
+            (Some(Moments::Principal(m)), _)
+                if let Some((k, turned)) = attitude.before_last_rotation(&|s| self.rate(s))
+                    && m[(k + 1) % 3].to_string() == m[(k + 2) % 3].to_string() =>
+            {
+                let quadratic = Moments::Principal(m.clone()).quadratic(&turned);
+                kinetic.push(mul([half.clone(), quadratic]));
+            }
             (Some(moments), _) => {
                 let body_frame: Vec3 = std::array::from_fn(|i| {
                     self.named(
@@ -173,15 +208,15 @@ impl Layer<'_> {
                     .push(Spanned::new(decl.span(), v.to_string()));
             }
         }
-        let rotation = attitude.rotation();
         self.bodies.insert(
             id.clone(),
             Body {
                 position,
                 velocity,
                 omega,
-                rotation,
+                rotation: attitude_rotation,
                 radius,
+                disk,
             },
         );
     }

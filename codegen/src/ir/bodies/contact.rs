@@ -50,7 +50,7 @@ impl Layer<'_> {
 
     /// Checks that `n` is a constant unit vector at the file's values and
     /// gives the axis of its largest component.
-    fn unit_vector(&mut self, n: &Vec3, at: Range<usize>) -> Option<usize> {
+    pub(super) fn unit_vector(&mut self, n: &Vec3, at: Range<usize>) -> Option<usize> {
         let values: Option<Vec<f64>> = n.iter().map(|c| self.value(c)).collect();
         let Some(values) = values else {
             self.cx.error(
@@ -162,11 +162,28 @@ impl Layer<'_> {
         let Some(body) = self.find(&r.body) else {
             return;
         };
+        if let Some((radius, axis)) = &body.disk {
+            let Shape::Plane(n, offset, k) = &shape else {
+                self.cx.error(
+                    structure("a disk rolls on a `plane` (not inside a sphere or cylinder yet)"),
+                    Some(decl.span()),
+                );
+                return;
+            };
+            if let Some(rows) = self.disk_on_plane(decl, &body, radius, axis, n, offset, *k) {
+                for row in rows {
+                    self.out
+                        .constraints
+                        .push(Spanned::new(decl.span(), row.to_string()));
+                }
+            }
+            return;
+        }
         let Some(radius) = body.radius.clone() else {
             let id = r.body.get_ref().clone();
             self.cx.error(
                 structure(format!(
-                    "body `{id}` rolls, so it needs `radius`, its contact sphere's"
+                    "body `{id}` rolls, so it needs a contact shape: `radius` (a sphere) or `disk`"
                 )),
                 Some(r.body.span()),
             );
@@ -217,6 +234,53 @@ impl Layer<'_> {
             return None;
         }
         Some(rows)
+    }
+
+    /// A disk (radius R, axis e) on a plane (unit normal n): it touches at
+    /// the rim's point nearest the plane, C = S − R u with u = w/|w|,
+    /// w = n − (n·e)e, and its centre's height h = n·S − offset is R|w|.
+    /// The position must say so by its coordinates (as z = R sin θ does
+    /// for z-x-z angles), which is checked at sample coordinates (h² =
+    /// R²|w|²); then u = R w/h, with no square root, and C − S = −R² w/h.
+    /// The rows are C's velocity across the normal's largest axis.
+    #[allow(clippy::too_many_arguments)]
+    fn disk_on_plane(
+        &mut self,
+        decl: &Spanned<RollingDecl>,
+        body: &Body,
+        radius: &Sym,
+        e: &Vec3,
+        n: &Vec3,
+        offset: &Sym,
+        k: usize,
+    ) -> Option<Vec<Sym>> {
+        let w = minus(n, &scale(&dot(n, e), e));
+        let h = sub(dot(n, &body.position), offset.clone());
+        let gap = sub(
+            square(h.clone()),
+            mul([square(radius.clone()), dot(&w, &w)]),
+        );
+        let scale_of = self.value(&square(radius.clone())).unwrap_or(1.0);
+        match self.largest_over_coordinates(&gap) {
+            Some(worst) if worst <= 1e-9 * (1.0 + scale_of) => {}
+            found => {
+                let why = match found {
+                    Some(worst) => format!(
+                        "here the squares of the two differ by up to {worst:.3} at sample coordinates"
+                    ),
+                    None => "it has no value at enough sample coordinates to check".to_string(),
+                };
+                self.cx.error(
+                    structure(format!(
+                        "a disk of radius R touching a plane keeps its centre at the height R·sqrt(1 − (n·e)²) above it (e its axis): write its position by coordinates that keep it there (the height R sin θ for z-x-z angles with the axis along the body's z); {why}"
+                    )),
+                    Some(decl.span()),
+                );
+                return None;
+            }
+        }
+        let offset = scale(&div(mul([int(-1), square(radius.clone())]), h), &w);
+        Some(Self::no_slip(body, &offset, Some(k)))
     }
 
     /// A ball inside a sphere or a cylinder of radius R: its centre keeps
@@ -378,6 +442,13 @@ impl Layer<'_> {
         let Some(body) = self.find(&body_name) else {
             return;
         };
+        if body.disk.is_some() {
+            self.cx.error(
+                structure("walls for a disk are not derived yet: write the wall's `surface` (and `contact`) by hand, without `body`"),
+                Some(span.clone()),
+            );
+            return;
+        }
         let r = body.radius.clone().unwrap_or(int(0));
         let (surface, offset, k) = match &shape {
             Shape::Plane(n, offset, k) => (

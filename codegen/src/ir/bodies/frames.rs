@@ -134,6 +134,25 @@ impl Attitude {
         }
     }
 
+    /// For a sequence of angles: the axis of the last rotation, and the
+    /// angular velocity in the frame the first two rotations make,
+    /// α̇₃ a₃ + α̇₂ a₂ + α̇₁ R₂ᵀ a₁. It is the body frame's turned back by
+    /// the last angle about a₃, and free of that angle: where the moments
+    /// about the other two axes are equal (a coin, a wheel, a top spinning
+    /// about a₃), ½ ΣIᵢΩᵢ² is the same in it without sin²+cos² to cancel.
+    pub(super) fn before_last_rotation(&self, rate: &dyn Fn(&Sym) -> Sym) -> Option<(usize, Vec3)> {
+        let Attitude::Sequence { axes, angles } = self else {
+            return None;
+        };
+        let r2 = rotation(axes[1], &angles[1]);
+        let parts = [
+            scale(&rate(&angles[2]), &unit(axes[2])),
+            scale(&rate(&angles[1]), &unit(axes[1])),
+            scale(&rate(&angles[0]), &apply_transposed(&r2, &unit(axes[0]))),
+        ];
+        Some((axes[2], plus(&plus(&parts[0], &parts[1]), &parts[2])))
+    }
+
     /// The angular velocity in the fixed frame and in the body frame, with
     /// `rate` the time derivative of an expression of the coordinates.
     pub(super) fn angular_velocity(&self, rate: &dyn Fn(&Sym) -> Sym) -> (Vec3, Vec3) {

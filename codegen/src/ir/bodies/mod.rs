@@ -22,6 +22,10 @@
 //! - a ball rolling on a plane: its contact point C = S − r n at rest, as
 //!   the two rows Ċ · eᵢ across the normal's largest component, and the
 //!   height n · S − offset − r = 0 as a holonomic constraint where it varies;
+//! - a disk (radius R, axis e) rolling on a plane: its rim's point nearest
+//!   the plane, C = S − R u, u = w/|w|, w = n − (n·e)e, at rest; the
+//!   position keeps it on the plane (n·S − offset = R|w|, checked), so
+//!   that u = R w/(n·S − offset) needs no root;
 //! - a knife edge: (n × R b) · Ṡ = 0 for the blade b on the plane of normal n;
 //! - a wall by shape: the surface f, the signed distance of the body's
 //!   contact sphere (radius r, 0 for a point) to the plane, or, from inside
@@ -207,6 +211,8 @@ struct Body {
     omega: Vec3,
     rotation: frames::Mat3,
     radius: Option<Sym>,
+    /// A disk's radius and its axis in the fixed frame.
+    disk: Option<(Sym, Vec3)>,
 }
 
 struct Layer<'a> {
