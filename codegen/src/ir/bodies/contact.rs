@@ -260,24 +260,9 @@ impl Layer<'_> {
             square(h.clone()),
             mul([square(radius.clone()), dot(&w, &w)]),
         );
-        let scale_of = self.value(&square(radius.clone())).unwrap_or(1.0);
-        match self.largest_over_coordinates(&gap) {
-            Some(worst) if worst <= 1e-9 * (1.0 + scale_of) => {}
-            found => {
-                let why = match found {
-                    Some(worst) => format!(
-                        "here the squares of the two differ by up to {worst:.3} at sample coordinates"
-                    ),
-                    None => "it has no value at enough sample coordinates to check".to_string(),
-                };
-                self.cx.error(
-                    structure(format!(
-                        "a disk of radius R touching a plane keeps its centre at the height R·sqrt(1 − (n·e)²) above it (e its axis): write its position by coordinates that keep it there (the height R sin θ for z-x-z angles with the axis along the body's z); {why}"
-                    )),
-                    Some(decl.span()),
-                );
-                return None;
-            }
+        let held = "a disk of radius R touching a plane keeps its centre at the height R·sqrt(1 − (n·e)²) above it (e its axis): write its position by coordinates that keep it there (the height R sin θ for z-x-z angles with the axis along the body's z)";
+        if !self.kept_by_coordinates(&gap, &square(radius.clone()), held, decl.span()) {
+            return None;
         }
         let offset = scale(&div(mul([int(-1), square(radius.clone())]), h), &w);
         Some(Self::no_slip(body, &offset, Some(k)))
@@ -303,24 +288,9 @@ impl Layer<'_> {
         let d = across(&body.position, c, axis);
         let reach = sub(big.clone(), radius.clone());
         let gap = sub(square(reach.clone()), dot(&d, &d));
-        let scale_of = self.value(&square(reach.clone())).unwrap_or(1.0);
-        match self.largest_over_coordinates(&gap) {
-            Some(worst) if worst <= 1e-9 * (1.0 + scale_of) => {}
-            found => {
-                let why = match found {
-                    Some(worst) => format!(
-                        "here the squares of the two differ by up to {worst:.3} at sample coordinates"
-                    ),
-                    None => "it has no value at enough sample coordinates to check".to_string(),
-                };
-                self.cx.error(
-                    structure(format!(
-                        "a ball rolling inside a sphere or cylinder of radius R keeps its centre at R − r from the centre (axis): write its position by coordinates that keep it there (two angles, say); {why}"
-                    )),
-                    Some(decl.span()),
-                );
-                return None;
-            }
+        let held = "a ball rolling inside a sphere or cylinder of radius R keeps its centre at R − r from the centre (axis): write its position by coordinates that keep it there (two angles, say)";
+        if !self.kept_by_coordinates(&gap, &square(reach.clone()), held, decl.span()) {
+            return None;
         }
         let Some(t) = self
             .coordinates
@@ -338,6 +308,31 @@ impl Layer<'_> {
         let offset = scale(&div(radius.clone(), reach), &d);
         let slip = plus(&body.velocity, &cross(&body.omega, &offset));
         Some(vec![dot(&slip, &t), dot(&slip, &other)])
+    }
+
+    /// Whether the coordinates keep `gap` (a difference of squares, of the
+    /// size of `size`) at zero, by [`Layer::largest_over_coordinates`];
+    /// otherwise an error at `span` saying `held` and by how much.
+    fn kept_by_coordinates(
+        &mut self,
+        gap: &Sym,
+        size: &Sym,
+        held: &str,
+        span: Range<usize>,
+    ) -> bool {
+        let scale_of = self.value(size).unwrap_or(1.0);
+        let why = match self.largest_over_coordinates(gap) {
+            Some(worst) if worst <= 1e-9 * (1.0 + scale_of) => return true,
+            Some(worst) => {
+                format!(
+                    "here the squares of the two differ by up to {worst:.3} at sample coordinates"
+                )
+            }
+            None => "it has no value at enough sample coordinates to check".to_string(),
+        };
+        self.cx
+            .error(structure(format!("{held}; {why}")), Some(span));
+        false
     }
 
     /// The largest |e| at sample values of the coordinates (the parameters
