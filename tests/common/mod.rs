@@ -184,3 +184,12 @@ pub fn pendulum_time(l: f64, g: f64, theta0: f64, theta: f64) -> f64 {
     let phi = ((theta / 2.0).sin() / k).asin();
     (l / g).sqrt() * (elliptic_f(std::f64::consts::FRAC_PI_2, k) + elliptic_f(phi, k))
 }
+
+/// The derivation of the model file `dir/name.toml` (`dir` from the crate's
+/// root), or a panic saying why not.
+pub fn derived(dir: &str, name: &str) -> dalembert_codegen::Derivation {
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join(dir)
+        .join(format!("{name}.toml"));
+    dalembert_codegen::derive(&file).unwrap_or_else(|e| panic!("{dir}/{name}: {e}"))
+}
