@@ -23,22 +23,17 @@ use dalembert_codegen::interpret::Interpreted;
 /// spin ψ̇ = w and no turning it rolls straight, x = −R w t, staying
 /// upright; upright turning about its vertical diameter (φ̇ = Ω, ψ̇ = 0)
 /// its centre stays put; tilted at θ₀ with the precession and spin of
-/// the steady motion (derived below) it keeps θ₀, φ̇ and ψ̇. From a tilted, turning start, along the run the
-/// energy is kept and the rim's point nearest the floor, computed here as
-/// C = S − R u with u = R_z(φ) R_x(θ) e_y, is at rest.
+/// the steady motion (derived below) it keeps θ₀, φ̇ and ψ̇. From a
+/// tilted, turning start, along the run the energy is kept and the rim's
+/// point nearest the floor, computed here as C = S − R u with
+/// u = R_z(φ) R_x(θ) e_y, is at rest.
 #[test]
 fn a_rolling_coin_moves_as_theory_says() {
     let d = derived("tests/bodies", "coin");
     let m = Interpreted::<5>::new(&d).unwrap();
     let r = 0.5;
     let settings = common::dormand_prince(1e-12);
-    let given = [false, false, true, true, true];
-    let start = |theta: f64, rates: [f64; 3]| {
-        let q = [0.0, 0.0, 0.3, theta, 0.0];
-        let v = [0.0, 0.0, rates[0], rates[1], rates[2]];
-        let (v, _) = dalembert::runtime::simulate::starting_velocity(&m, &q, &v, &given).unwrap();
-        State { t: 0.0, q, v }
-    };
+    let start = |theta: f64, rates: [f64; 3]| coin_start(&m, [0.0, 0.0, 0.3, theta, 0.0], rates);
     let upright = std::f64::consts::FRAC_PI_2;
 
     // Rolling straight along the heading φ = 0.3.
@@ -131,6 +126,82 @@ fn a_rolling_coin_moves_as_theory_says() {
         worst.0,
         worst.1
     );
+}
+
+/// A coin's start at `q` with the angle rates (φ̇, θ̇, ψ̇) given, the
+/// centre's velocity following from the rolling rows.
+fn coin_start<M: Dynamics<5>>(m: &M, q: [f64; 5], rates: [f64; 3]) -> State<5> {
+    let v = [0.0, 0.0, rates[0], rates[1], rates[2]];
+    let given = [false, false, true, true, true];
+    let (v, _) = dalembert::runtime::simulate::starting_velocity(m, &q, &v, &given).unwrap();
+    State { t: 0.0, q, v }
+}
+
+/// The coin between two smooth walls (tests/bodies/coin_walls.toml, the
+/// walls' surfaces derived from the disk: f = n·S − offset − R√(1 − (n·e)²)).
+/// Upright and rolling head-on into the wall x = 0 at speed R w from
+/// x = 3/2, it meets it at t = (3/2 − R)/(R w), when the centre is R from
+/// it, and leaves with every velocity reversed (by symmetry the smooth law
+/// with the rolling rows gives v⁺ = −v⁻). Tilted, turning and bouncing
+/// between the walls, the energy is kept and A v = 0 through each impact.
+#[test]
+fn a_coin_bounces_off_smooth_walls() {
+    let d = derived("tests/bodies", "coin_walls");
+    let m = Interpreted::<5>::new(&d).unwrap();
+    let r = 0.5;
+    let settings = common::dormand_prince(1e-12);
+    let start = |x: f64, phi: f64, theta: f64, rates: [f64; 3]| {
+        coin_start(&m, [x, 0.0, phi, theta, 0.0], rates)
+    };
+    let w = 2.0;
+    let x0 = start(1.5, 0.0, std::f64::consts::FRAC_PI_2, [0.0, 0.0, w]);
+    assert!((x0.v[0] + r * w).abs() < 1e-12, "{x0:?}");
+    let mut sim = Simulator::new(&m, x0, settings).unwrap();
+    let mut hits = Vec::new();
+    sim.run(1.5, |step| {
+        if let Some(c) = &step.collision {
+            hits.push((c.t, c.q, c.v_minus, c.v_plus));
+        }
+        true
+    })
+    .unwrap();
+    assert_eq!(hits.len(), 1, "{hits:?}");
+    let (t, q, before, after) = hits[0];
+    assert!((t - (1.5 - r) / (r * w)).abs() < 1e-10, "met at {t}");
+    assert!((q[0] - r).abs() < 1e-10, "{q:?}");
+    for i in 0..5 {
+        assert!(
+            (after[i] + before[i]).abs() < 1e-10,
+            "{before:?} -> {after:?}"
+        );
+    }
+    assert!(
+        (sim.state().q[0] - (r + r * w * 0.5)).abs() < 1e-9,
+        "{:?}",
+        sim.state()
+    );
+
+    let x0 = start(1.5, 0.3, 1.3, [0.8, 0.0, 7.0]);
+    let energy = |q: &[f64; 5], v: &[f64; 5]| m.kinetic_energy(q, v) + m.potential(q);
+    let e0 = energy(&x0.q, &x0.v);
+    let mut sim = Simulator::new(&m, x0, settings).unwrap();
+    let (mut collisions, mut worst) = (0, 0.0f64);
+    sim.run(6.0, |step| {
+        let (q, v) = (&step.state.q, &step.state.v);
+        worst = worst.max((energy(q, v) - e0).abs() / e0);
+        worst = worst.max(
+            m.constraints(q)
+                .as_slice()
+                .iter()
+                .map(|row| row.iter().zip(v).map(|(a, b)| a * b).sum::<f64>().abs())
+                .fold(0.0, f64::max),
+        );
+        collisions += usize::from(step.collision.is_some());
+        true
+    })
+    .unwrap();
+    assert!(collisions >= 2, "{collisions} collisions");
+    assert!(worst < 1e-9, "energy or A v off by {worst:e}");
 }
 
 /// A bob on a spring (k, rest length L) from a fixed point H above the

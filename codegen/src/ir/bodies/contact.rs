@@ -7,9 +7,10 @@ use std::ops::Range;
 
 use toml::Spanned;
 
+use super::super::Function;
 use super::super::file::{KnifeEdgeDecl, PlaneDecl, RollingDecl, RoundDecl, WallDecl};
 use super::frames::{self, Vec3, cross, dot, minus, plus, scale};
-use super::sym::{Sym, div, int, mul, square, sub};
+use super::sym::{Sym, call, div, int, mul, square, sub};
 use super::{Body, Layer, structure};
 
 /// A surface by shape: a plane (unit normal, offset, the normal's largest
@@ -437,21 +438,39 @@ impl Layer<'_> {
         let Some(body) = self.find(&body_name) else {
             return;
         };
-        if body.disk.is_some() {
-            self.cx.error(
-                structure("walls for a disk are not derived yet: write the wall's `surface` (and `contact`) by hand, without `body`"),
-                Some(span.clone()),
-            );
-            return;
-        }
         let r = body.radius.clone().unwrap_or(int(0));
-        let (surface, offset, k) = match &shape {
-            Shape::Plane(n, offset, k) => (
+        let (surface, offset, k) = match (&shape, &body.disk) {
+            // A disk (radius R, axis e) meets the plane at its rim's point
+            // nearest it, R u from the centre, u = w/|w|, w = n − (n·e)e:
+            // f = n·S − offset − R|w|. (Where e is along n the disk lies
+            // flat against the wall and f has no derivative.)
+            (Shape::Plane(n, offset, k), Some((radius, e))) => {
+                let along = dot(n, e);
+                let w = minus(n, &scale(&along, e));
+                // |w|² = 1 − (n·e)² for the unit vectors n and e.
+                let size = call(Function::Sqrt, sub(int(1), square(along)));
+                (
+                    sub(
+                        sub(dot(n, &body.position), offset.clone()),
+                        mul([radius.clone(), size.clone()]),
+                    ),
+                    scale(&div(mul([int(-1), radius.clone()]), size), &w),
+                    Some(*k),
+                )
+            }
+            (Shape::Round(..), Some(_)) => {
+                self.cx.error(
+                    structure("a disk meets a `plane` wall (not a sphere or cylinder yet)"),
+                    Some(span.clone()),
+                );
+                return;
+            }
+            (Shape::Plane(n, offset, k), None) => (
                 sub(sub(dot(n, &body.position), offset.clone()), r.clone()),
                 scale(&mul([int(-1), r.clone()]), n),
                 Some(*k),
             ),
-            Shape::Round(c, axis, big) => {
+            (Shape::Round(c, axis, big), None) => {
                 let d = across(&body.position, c, axis.as_ref());
                 let reach = sub(big.clone(), r.clone());
                 let f = div(
@@ -462,6 +481,16 @@ impl Layer<'_> {
                 (f, scale(&div(r.clone(), reach), &d), None)
             }
         };
+        if rough && body.disk.is_some() {
+            // Its rows would be the rim point's velocity through the root
+            // |w|, in which the exact rank test cannot see that they and a
+            // rolling disk's rows are dependent.
+            self.cx.error(
+                structure("a rough wall for a disk is not derived yet: write its `surface` and `contact` by hand, or make it `smooth`"),
+                w.law.as_ref().map(|l| l.span()),
+            );
+            return;
+        }
         let rows = if rough {
             if body.radius.is_none() {
                 self.cx.error(

@@ -25,7 +25,8 @@
 //! - a disk (radius R, axis e) rolling on a plane: its rim's point nearest
 //!   the plane, C = S − R u, u = w/|w|, w = n − (n·e)e, at rest; the
 //!   position keeps it on the plane (n·S − offset = R|w|, checked), so
-//!   that u = R w/(n·S − offset) needs no root;
+//!   that u = R w/(n·S − offset) needs no root; a smooth plane wall meets
+//!   it at the rim's point nearest it, f = n·S − offset − R√(1 − (n·e)²);
 //! - a knife edge: (n × R b) · Ṡ = 0 for the blade b on the plane of normal n;
 //! - a wall by shape: the surface f, the signed distance of the body's
 //!   contact sphere (radius r, 0 for a point) to the plane, or, from inside
