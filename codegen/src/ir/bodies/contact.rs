@@ -255,12 +255,9 @@ impl Layer<'_> {
         offset: &Sym,
         k: usize,
     ) -> Option<Vec<Sym>> {
-        let w = minus(n, &scale(&dot(n, e), e));
+        let (w, size2) = toward(n, e);
         let h = sub(dot(n, &body.position), offset.clone());
-        let gap = sub(
-            square(h.clone()),
-            mul([square(radius.clone()), dot(&w, &w)]),
-        );
+        let gap = sub(square(h.clone()), mul([square(radius.clone()), size2]));
         let held = "a disk of radius R touching a plane keeps its centre at the height R·sqrt(1 − (n·e)²) above it (e its axis): write its position by coordinates that keep it there (the height R sin θ for z-x-z angles with the axis along the body's z)";
         if !self.kept_by_coordinates(&gap, &square(radius.clone()), held, decl.span()) {
             return None;
@@ -445,10 +442,8 @@ impl Layer<'_> {
             // f = n·S − offset − R|w|. (Where e is along n the disk lies
             // flat against the wall and f has no derivative.)
             (Shape::Plane(n, offset, k), Some((radius, e))) => {
-                let along = dot(n, e);
-                let w = minus(n, &scale(&along, e));
-                // |w|² = 1 − (n·e)² for the unit vectors n and e.
-                let size = call(Function::Sqrt, sub(int(1), square(along)));
+                let (w, size2) = toward(n, e);
+                let size = call(Function::Sqrt, size2);
                 (
                     sub(
                         sub(dot(n, &body.position), offset.clone()),
@@ -512,6 +507,14 @@ impl Layer<'_> {
             .map(|r| Spanned::new(span.clone(), r.to_string()))
             .collect();
     }
+}
+
+/// The direction in a disk's plane (axis e) toward the plane of normal n,
+/// w = n − (n·e)e, and |w|² = 1 − (n·e)² (n and e unit vectors): the rim's
+/// point nearest the plane is R w/|w| from the centre.
+fn toward(n: &Vec3, e: &Vec3) -> (Vec3, Sym) {
+    let along = dot(n, e);
+    (minus(n, &scale(&along, e)), sub(int(1), square(along)))
 }
 
 /// The position `p` from a sphere's centre `c`, or from a cylinder's axis
