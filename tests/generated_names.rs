@@ -4,8 +4,9 @@
 //! generates is compiled against the runtime by rustc in one crate. Uses the
 //! symbolic engine: run one test at a time (`RUST_TEST_THREADS=1`).
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
@@ -133,19 +134,6 @@ fn model(
     )
 }
 
-/// The runtime's rlib next to this test binary (the newest, if several).
-fn runtime_rlib(deps: &Path) -> PathBuf {
-    std::fs::read_dir(deps)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| {
-            let name = p.file_name().unwrap().to_string_lossy().into_owned();
-            name.starts_with("libdalembert_runtime-") && name.ends_with(".rlib")
-        })
-        .max_by_key(|p| p.metadata().unwrap().modified().unwrap())
-        .expect("the runtime's rlib is built before the tests")
-}
-
 #[test]
 fn every_generated_file_compiles() {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("generated-names");
@@ -206,26 +194,11 @@ fn every_generated_file_compiles() {
 
 /// rustc on `dir/lib.rs` as a library crate against the runtime.
 fn compile(dir: &Path, crate_name: &str) -> std::process::Output {
-    let deps = std::env::current_exe()
-        .unwrap()
-        .parent()
-        .unwrap()
-        .to_path_buf();
-    Command::new(std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into()))
-        .args(["--edition", "2024", "--crate-type", "lib", "--crate-name"])
-        .arg(crate_name)
-        .arg("-L")
-        .arg(format!("dependency={}", deps.display()))
-        .arg("--extern")
-        .arg(format!(
-            "dalembert_runtime={}",
-            runtime_rlib(&deps).display()
-        ))
-        .arg("--out-dir")
-        .arg(dir)
-        .arg(dir.join("lib.rs"))
-        .output()
-        .expect("rustc runs")
+    common::rustc(
+        dir,
+        "lib.rs",
+        &["--crate-type", "lib", "--crate-name", crate_name],
+    )
 }
 
 /// Text from the model file reaches generated code only as inert comment

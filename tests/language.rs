@@ -129,6 +129,77 @@ fn close(what: &str, got: f64, want: f64, tol: f64) {
     );
 }
 
+/// T, V, G and the forcing h of G q̈ + h = Aᵀλ (∂²T/∂v∂q · q̇ − ∂T/∂q +
+/// ∂V/∂q) emitted for `d` at `inputs` (parameters, q, v) against the
+/// formulas `t` and `potential` and their numeric derivatives.
+fn check_energies(
+    d: &Derivation,
+    inputs: &[f64],
+    q: &[f64],
+    v: &[f64],
+    t: &dyn Fn(&[f64], &[f64]) -> f64,
+    potential: &dyn Fn(&[f64]) -> f64,
+) {
+    let n = q.len();
+    close(
+        "T",
+        eval(d, Quantity::KineticEnergy, inputs)[0],
+        t(q, v),
+        1e-12,
+    );
+    close(
+        "V",
+        eval(d, Quantity::Potential, inputs)[0],
+        potential(q),
+        1e-12,
+    );
+    let g = eval(d, Quantity::MassMatrix, inputs);
+    for i in 0..n {
+        for j in 0..n {
+            let tv = |w: &[f64]| t(q, w);
+            let dj = |w: &[f64]| partial(&tv, w, j);
+            close(
+                &format!("G[{i}][{j}]"),
+                g[n * i + j],
+                partial(&dj, v, i),
+                1e-5,
+            );
+        }
+    }
+    let forcing = eval(d, Quantity::Forcing, inputs);
+    for (i, &got) in forcing.iter().enumerate().take(n) {
+        let dt_dvi = |x: &[f64], w: &[f64]| partial(&|u: &[f64]| t(x, u), w, i);
+        let mixed: f64 = (0..n)
+            .map(|j| partial(&|x: &[f64]| dt_dvi(x, v), q, j) * v[j])
+            .sum();
+        let want = mixed - partial(&|x: &[f64]| t(x, v), q, i) + partial(potential, q, i);
+        close(&format!("forcing[{i}]"), got, want, 1e-5);
+    }
+}
+
+/// Wall `w`'s f, df and vᵀ∇²f v emitted for `d` against its formula `f`.
+fn check_wall(
+    d: &Derivation,
+    w: usize,
+    inputs: &[f64],
+    q: &[f64],
+    v: &[f64],
+    f: &dyn Fn(&[f64]) -> f64,
+) {
+    close(
+        "f",
+        wall_eval(d, w, Quantity::Surface, inputs)[0],
+        f(q),
+        1e-12,
+    );
+    let normal = wall_eval(d, w, Quantity::Normal, inputs);
+    for (k, &df) in normal.iter().enumerate().take(q.len()) {
+        close(&format!("df[{k}]"), df, partial(f, q, k), 1e-7);
+    }
+    let hess = wall_eval(d, w, Quantity::SurfaceHessian, inputs)[0];
+    close("vᵀ∇²f v", hess, second_along(f, q, v), 1e-4);
+}
+
 #[test]
 fn every_function_and_constant_reaches_the_emitted_programs() {
     let d = derive("everything", EVERYTHING);
@@ -138,38 +209,13 @@ fn every_function_and_constant_reaches_the_emitted_programs() {
         let v: Vec<f64> = (0..4).map(|_| 2.0 * common::lcg(&mut seed) - 1.0).collect();
         let inputs: Vec<f64> = PARAMS.iter().chain(&q).chain(&v).copied().collect();
 
-        close(
-            "T",
-            eval(&d, Quantity::KineticEnergy, &inputs)[0],
-            t(&q, &v),
-            1e-12,
-        );
-        close(
-            "V",
-            eval(&d, Quantity::Potential, &inputs)[0],
-            potential(&q),
-            1e-12,
-        );
+        check_energies(&d, &inputs, &q, &v, &t, &potential);
         close(
             "h",
             eval(&d, Quantity::Holonomic, &inputs)[0],
             holonomic(&q),
             1e-12,
         );
-
-        let g = eval(&d, Quantity::MassMatrix, &inputs);
-        for i in 0..4 {
-            for j in 0..4 {
-                let tv = |w: &[f64]| t(&q, w);
-                let dj = |w: &[f64]| partial(&tv, w, j);
-                close(
-                    &format!("G[{i}][{j}]"),
-                    g[4 * i + j],
-                    partial(&dj, &v, i),
-                    1e-5,
-                );
-            }
-        }
 
         // Rows of A: dh first, then the velocity constraint.
         let a = eval(&d, Quantity::Constraints, &inputs);
@@ -195,33 +241,8 @@ fn every_function_and_constant_reaches_the_emitted_programs() {
         let along: f64 = (0..4).map(|j| partial(&av, &q, j) * v[j]).sum();
         close("drift of A v", drift[1], along, 1e-6);
 
-        // h of G q̈ + h = Aᵀλ: ∂²T/∂v∂q · q̇ − ∂T/∂q + ∂V/∂q.
-        let forcing = eval(&d, Quantity::Forcing, &inputs);
-        for (i, &got) in forcing.iter().enumerate().take(4) {
-            let dt_dvi = |x: &[f64], w: &[f64]| {
-                let tw = |u: &[f64]| t(x, u);
-                partial(&tw, w, i)
-            };
-            let mixed: f64 = (0..4)
-                .map(|j| partial(&|x: &[f64]| dt_dvi(x, &v), &q, j) * v[j])
-                .sum();
-            let want = mixed - partial(&|x: &[f64]| t(x, &v), &q, i) + partial(&potential, &q, i);
-            close(&format!("forcing[{i}]"), got, want, 1e-5);
-        }
-
         for (w, f) in [(0, rim as fn(&[f64]) -> f64), (1, floor)] {
-            close(
-                "f",
-                wall_eval(&d, w, Quantity::Surface, &inputs)[0],
-                f(&q),
-                1e-12,
-            );
-            let normal = wall_eval(&d, w, Quantity::Normal, &inputs);
-            for (k, &df) in normal.iter().enumerate().take(4) {
-                close(&format!("df[{k}]"), df, partial(&f, &q, k), 1e-7);
-            }
-            let hess = wall_eval(&d, w, Quantity::SurfaceHessian, &inputs)[0];
-            close("vᵀ∇²f v", hess, second_along(&f, &q, &v), 1e-4);
+            check_wall(&d, w, &inputs, &q, &v, &f);
         }
     }
     // The same programs in f32.
@@ -475,4 +496,164 @@ fn numbers_never_wrap_around() {
     let text = "[model]\nname = \"wrap\"\n[parameters]\nm = \"1/-170141183460469231731687303715884105728\"\n[coordinates]\nnames = [\"x\"]\n[dynamics]\nkinetic_energy = \"m*x_dot^2/2\"\n[[wall]]\nname = \"floor\"\nsurface = \"x\"\n";
     let e = dalembert_codegen::ir::parse(std::path::Path::new("wrap.toml"), text).unwrap_err();
     assert!(e.to_string().contains("too large"), "{e}");
+}
+
+/// The arc and hyperbolic functions in T, V, a constraint and a wall.
+const ARCS: &str = r#"
+[model]
+name = "arcs"
+
+[parameters]
+m = 2
+
+[coordinates]
+names = ["x", "y"]
+
+[dynamics]
+kinetic_energy = "m/2*cosh(y/2)*x_dot^2 + (1 + atan(x)^2)/2*y_dot^2"
+potential = "sinh(x/3)*tanh(y) + asin(x/4) - acos(y/5)"
+constraints = ["tanh(x)*x_dot + cosh(y)*y_dot"]
+
+[[wall]]
+name = "rim"
+surface = "2 - atan(x)^2 - sinh(y)^2 + asin(x/5)*acos(y/5)"
+"#;
+
+/// The same in T, V and a wall, with no constraint: q̈ in closed form,
+/// so the model has Taylor series.
+const ARCS_FREE: &str = r#"
+[model]
+name = "arcs_free"
+
+[parameters]
+m = 2
+
+[coordinates]
+names = ["x", "y"]
+
+[dynamics]
+kinetic_energy = "m/2*cosh(y/2)*x_dot^2 + (1 + atan(x)^2)/2*y_dot^2"
+potential = "sinh(x/3)*tanh(y) + asin(x/4) - acos(y/5)"
+
+[[wall]]
+name = "rim"
+surface = "2 - atan(x)^2 - sinh(y)^2 + asin(x/5)*acos(y/5)"
+"#;
+
+/// The arc and hyperbolic functions in every part: T, V, a constraint and a
+/// wall, checked like [`EVERYTHING`] against the formulas and their
+/// numeric derivatives, and present in the f32 programs as libm's f32
+/// functions.
+#[test]
+fn arc_and_hyperbolic_functions_reach_the_emitted_programs() {
+    let t = |q: &[f64], v: &[f64]| {
+        (q[1] / 2.0).cosh() * v[0] * v[0] + (1.0 + q[0].atan().powi(2)) / 2.0 * v[1] * v[1]
+    };
+    let potential =
+        |q: &[f64]| (q[0] / 3.0).sinh() * q[1].tanh() + (q[0] / 4.0).asin() - (q[1] / 5.0).acos();
+    let rim = |q: &[f64]| {
+        2.0 - q[0].atan().powi(2) - q[1].sinh().powi(2) + (q[0] / 5.0).asin() * (q[1] / 5.0).acos()
+    };
+    let d = derive("arcs", ARCS);
+    let mut seed = 11u64;
+    for _ in 0..20 {
+        let q: Vec<f64> = (0..2).map(|_| 2.0 * common::lcg(&mut seed) - 1.0).collect();
+        let v: Vec<f64> = (0..2).map(|_| 2.0 * common::lcg(&mut seed) - 1.0).collect();
+        let inputs: Vec<f64> = [2.0].iter().chain(&q).chain(&v).copied().collect();
+        check_energies(&d, &inputs, &q, &v, &t, &potential);
+        let a = eval(&d, Quantity::Constraints, &inputs);
+        close("A[0]", a[0], q[0].tanh(), 1e-12);
+        close("A[1]", a[1], q[1].cosh(), 1e-12);
+        check_wall(&d, 0, &inputs, &q, &v, &rim);
+    }
+    let f32_code = with_model_file("arcs", ARCS, |path| {
+        dalembert_codegen::generate_f32(path).unwrap()
+    });
+    for f in ["atanf", "asinf", "acosf", "sinhf", "coshf", "tanhf"] {
+        assert!(f32_code.contains(f), "{f} in the f32 programs");
+    }
+}
+
+/// The emitted Taylor series through the arc and hyperbolic functions (an
+/// arc function's recurrence c′w = a′, a hyperbolic one's exponentials),
+/// compiled by rustc and run, against the interpreter's: q, q̇ and a wall's
+/// f to order 12, from a state inside the functions' domains.
+#[test]
+fn emitted_series_of_arc_and_hyperbolic_functions_match_the_interpreter() {
+    use dalembert::runtime::taylor::{Coefficients, Series};
+    use dalembert::runtime::{Dynamics, Surfaces, Walls};
+    let d = derive("arcs_free", ARCS_FREE);
+    let code = with_model_file("arcs_free", ARCS_FREE, |path| {
+        dalembert_codegen::generate(path).unwrap()
+    });
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("language-arcs");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("m.rs"), code).unwrap();
+    let (q, v) = ([0.3, -0.4], [0.7, 0.2]);
+    std::fs::write(
+        dir.join("main.rs"),
+        format!(
+            r#"
+#[path = "m.rs"]
+#[allow(dead_code)]
+mod m;
+use dalembert_runtime::taylor::Series;
+use dalembert_runtime::{{Dynamics, FromParams, Surfaces, Walls}};
+fn main() {{
+    let model = m::ArcsFree::with_params(Default::default());
+    let mut s = Series::at(&{q:?}, &{v:?});
+    let mut scratch = Default::default();
+    assert!(model.taylor_series(&mut s, &mut scratch, 12));
+    let mut f = [0.0; dalembert_runtime::taylor::CAPACITY];
+    assert!(model.surface_series(model.walls()[0], &s, &mut scratch, &mut f));
+    for c in s.q.iter().chain(&s.v).chain([&f]) {{
+        for x in &c[..=12] {{
+            println!("{{x:e}}");
+        }}
+    }}
+}}
+"#
+        ),
+    )
+    .unwrap();
+    let out = common::rustc(
+        &dir,
+        "main.rs",
+        &["--crate-type", "bin", "--crate-name", "arcs", "-O"],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let run = std::process::Command::new(dir.join("arcs"))
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let compiled: Vec<f64> = String::from_utf8(run.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| l.parse().unwrap())
+        .collect();
+    let m = dalembert_codegen::interpret::Interpreted::<2>::new(&d).unwrap();
+    // (The interpreter's series keep no scratch of the caller's.)
+    let mut s = Series::at(&q, &v);
+    assert!(m.taylor_series(&mut s, &mut (), 12));
+    let mut f: Coefficients = [0.0; dalembert::runtime::taylor::CAPACITY];
+    assert!(m.surface_series(m.walls()[0], &s, &mut (), &mut f));
+    let interpreted: Vec<f64> = (s.q.iter().chain(&s.v).chain([&f]))
+        .flat_map(|c| c[..=12].to_vec())
+        .collect();
+    assert_eq!(compiled.len(), interpreted.len());
+    for (i, (a, b)) in compiled.iter().zip(&interpreted).enumerate() {
+        assert!(
+            (a - b).abs() <= 1e-13 * (1.0 + b.abs()),
+            "coefficient {i}: compiled {a:e}, interpreted {b:e}"
+        );
+    }
 }

@@ -104,6 +104,12 @@ fn saltation_matches_differences_of_the_flow_through_a_collision() {
         ("disk_quotient", 1.0),
         ("disk_thin_ring", 1.0),
         ("oval_exp", 2.0),
+        ("disk_atan", 1.0),
+        ("disk_asin", 1.0),
+        ("disk_acos", 1.0),
+        ("disk_sinh", 1.0),
+        ("disk_cosh", 1.0),
+        ("disk_tanh", 1.0),
     ] {
         let m = model(name);
         let wall = m.walls()[0];

@@ -333,6 +333,13 @@ fn interpreted_models_with_nonpolynomial_walls() {
         "disk_thin_ring",
         "oval_exp",
         "pendulum_peg",
+        "disk_atan",
+        "disk_asin",
+        "disk_acos",
+        "disk_sinh",
+        "disk_cosh",
+        "disk_tanh",
+        "disk_functions",
     ] {
         run::<2>(name);
     }

@@ -66,7 +66,10 @@ pub enum ErrorKind {
         name: String,
     },
     /// An expression calls a function that models may not use.
-    #[error("unknown function `{name}`: models may use sin, cos, tan, exp, log and sqrt")]
+    #[error(
+        "unknown function `{name}`: models may use {}",
+        crate::ir::Function::listed()
+    )]
     UnknownFunction {
         /// The function's name.
         name: String,

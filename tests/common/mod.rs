@@ -193,3 +193,41 @@ pub fn derived(dir: &str, name: &str) -> dalembert_codegen::Derivation {
         .join(format!("{name}.toml"));
     dalembert_codegen::derive(&file).unwrap_or_else(|e| panic!("{dir}/{name}: {e}"))
 }
+
+/// The runtime's rlib these tests were built against, in `deps`.
+fn runtime_rlib(deps: &std::path::Path) -> std::path::PathBuf {
+    std::fs::read_dir(deps)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            let name = p.file_name().unwrap().to_string_lossy().into_owned();
+            name.starts_with("libdalembert_runtime-") && name.ends_with(".rlib")
+        })
+        .max_by_key(|p| p.metadata().unwrap().modified().unwrap())
+        .expect("the runtime's rlib is built before the tests")
+}
+
+/// rustc (edition 2024) on `dir/source` against the runtime, with `args`
+/// (crate type, name, options), writing into `dir`.
+pub fn rustc(dir: &std::path::Path, source: &str, args: &[&str]) -> std::process::Output {
+    let deps = std::env::current_exe()
+        .unwrap()
+        .parent()
+        .unwrap()
+        .to_path_buf();
+    std::process::Command::new(std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into()))
+        .args(["--edition", "2024"])
+        .args(args)
+        .arg("-L")
+        .arg(format!("dependency={}", deps.display()))
+        .arg("--extern")
+        .arg(format!(
+            "dalembert_runtime={}",
+            runtime_rlib(&deps).display()
+        ))
+        .arg("--out-dir")
+        .arg(dir)
+        .arg(dir.join(source))
+        .output()
+        .expect("rustc runs")
+}

@@ -257,7 +257,7 @@ fn permanent_bound(a: &[Vec<f64>]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::derive::build::{Namespace, own_symbol};
+    use crate::derive::build::{Differentiate, Namespace, own_symbol};
 
     /// The bound is exact for a power of a sum and for a product of sums,
     /// and never below the expanded count, through a square root too.
@@ -279,10 +279,7 @@ mod tests {
         assert_eq!(expansion_terms(&product), 6.0);
         assert!(count(&product) <= 6.0);
         let root = &one - cube.pow(Atom::num(1) / Atom::num(2));
-        for a in [
-            root.derivative(own_symbol("x")),
-            product.derivative(own_symbol("x")),
-        ] {
+        for a in [root.d(own_symbol("x")), product.d(own_symbol("x"))] {
             assert!(expansion_terms(&a) >= count(&a), "{a}");
         }
     }

@@ -62,6 +62,101 @@ pub fn own_symbol(name: &str) -> Symbol {
     NAMESPACE.with(|ns| symbol!(format!("{}::{name}", ns.borrow()).as_str()))
 }
 
+/// The functions of the language symbolica does not have, as functions of
+/// ours (atan, asin, acos, sinh, cosh, tanh).
+pub const OWN_FUNCTIONS: [Function; 6] = [
+    Function::Atan,
+    Function::Asin,
+    Function::Acos,
+    Function::Sinh,
+    Function::Cosh,
+    Function::Tanh,
+];
+
+/// The symbols of [`OWN_FUNCTIONS`] in the current namespace.
+pub fn own_functions() -> impl Iterator<Item = Symbol> {
+    OWN_FUNCTIONS.into_iter().map(|f| own_symbol(f.name()))
+}
+
+/// Differentiation that knows the functions of ours: symbolica leaves
+/// their derivatives unevaluated (`der(1, f, z)`), and [`Differentiate::d`]
+/// writes each out by its rule.
+pub trait Differentiate {
+    /// ∂/∂`x`.
+    fn d(&self, x: Symbol) -> Atom;
+}
+
+impl Differentiate for Atom {
+    fn d(&self, x: Symbol) -> Atom {
+        let d = self.derivative(x);
+        resolved(d.as_view()).unwrap_or(d)
+    }
+}
+
+/// `a` with every `der(1, f, z)` of a function of ours written out; `None`
+/// where it has none.
+fn resolved(a: AtomView) -> Option<Atom> {
+    let or_same = |x: AtomView| resolved(x).unwrap_or_else(|| x.to_owned());
+    match a {
+        AtomView::Fun(f) => {
+            let args: Vec<AtomView> = f.iter().collect();
+            if f.get_symbol().get_stripped_name() == "der"
+                && let [n, AtomView::Var(g), z] = args[..]
+                && n.to_owned() == Atom::num(1)
+                && let Some(rule) = OWN_FUNCTIONS
+                    .into_iter()
+                    .find(|h| own_symbol(h.name()) == g.get_symbol())
+            {
+                return Some(derivative_rule(rule, or_same(z)));
+            }
+            let [x] = args[..] else { return None };
+            resolved(x).map(|x| function!(f.get_symbol(), x))
+        }
+        AtomView::Add(s) => {
+            let parts: Vec<Option<Atom>> = s.iter().map(resolved).collect();
+            if parts.iter().all(Option::is_none) {
+                return None;
+            }
+            Some(s.iter().zip(parts).fold(Atom::num(0), |acc, (x, p)| {
+                acc + p.unwrap_or_else(|| x.to_owned())
+            }))
+        }
+        AtomView::Mul(m) => {
+            let parts: Vec<Option<Atom>> = m.iter().map(resolved).collect();
+            if parts.iter().all(Option::is_none) {
+                return None;
+            }
+            Some(m.iter().zip(parts).fold(Atom::num(1), |acc, (x, p)| {
+                acc * p.unwrap_or_else(|| x.to_owned())
+            }))
+        }
+        AtomView::Pow(p) => {
+            let (b, e) = p.get_base_exp();
+            if resolved(b).is_none() && resolved(e).is_none() {
+                return None;
+            }
+            Some(or_same(b).pow(or_same(e)))
+        }
+        _ => None,
+    }
+}
+
+/// f′(z) for a function of ours, in the functions the language has.
+fn derivative_rule(f: Function, z: Atom) -> Atom {
+    let one = Atom::num(1);
+    let square = z.clone().pow(Atom::num(2));
+    let half = Atom::num(1) / Atom::num(2);
+    match f {
+        Function::Atan => (one + square).pow(Atom::num(-1)),
+        Function::Asin => (one - square).pow(-half),
+        Function::Acos => -(one - square).pow(-half),
+        Function::Sinh => function!(own_symbol(Function::Cosh.name()), z),
+        Function::Cosh => function!(own_symbol(Function::Sinh.name()), z),
+        Function::Tanh => one - function!(own_symbol(Function::Tanh.name()), z).pow(Atom::num(2)),
+        _ => unreachable!("symbolica differentiates its own functions"),
+    }
+}
+
 /// The symbol of a model name.
 pub fn model_symbol(name: &str) -> Symbol {
     own_symbol(name)
@@ -170,6 +265,12 @@ pub fn build(node: &Node, definitions: &HashMap<String, Atom>) -> Result<Atom, B
                     }
                     arg.pow(Atom::num(1) / Atom::num(2))
                 }
+                Function::Atan
+                | Function::Asin
+                | Function::Acos
+                | Function::Sinh
+                | Function::Cosh
+                | Function::Tanh => function!(own_symbol(f.name()), arg),
             }
         }
     })

@@ -15,6 +15,7 @@ use std::ops::Range;
 
 use symbolica::prelude::*;
 
+use super::build::Differentiate;
 use super::evaluate::program;
 use super::mechanics::Raw;
 use super::sample::onto;
@@ -30,7 +31,7 @@ pub fn kinetic_energy_quadratic(sym: &Symbols, cx: &mut Collector, t: &Atom, g: 
     let span = sym.model.kinetic_energy.span.clone();
     for e in g.iter().flatten() {
         for (k, v) in sym.vels.iter().enumerate() {
-            if !is_zero(&e.derivative(*v)) {
+            if !is_zero(&e.d(*v)) {
                 cx.error(
                     ErrorKind::NotQuadratic(format!(
                         "its second derivatives still depend on `{}` (terms of degree > 2)",
@@ -79,13 +80,13 @@ pub fn linear_row(
     let mut row = Vec::with_capacity(sym.vels.len());
     let mut bound = budget::Running::default();
     for v in &sym.vels {
-        let d = e.derivative(*v);
+        let d = e.d(*v);
         bound.add(&d, cx, span, what)?;
         row.push(d.expand());
     }
     for c in &row {
         for (k, v) in sym.vels.iter().enumerate() {
-            if !is_zero(&c.derivative(*v)) {
+            if !is_zero(&c.d(*v)) {
                 return Err(cx.error(
                     ErrorKind::NotLinear(format!(
                         "its coefficients depend on the velocity `{}`",
@@ -125,7 +126,7 @@ pub fn no_velocity(
     kind: impl Fn(String) -> ErrorKind,
 ) {
     for (k, v) in sym.vels.iter().enumerate() {
-        if !is_zero(&e.derivative(*v)) {
+        if !is_zero(&e.d(*v)) {
             cx.error(kind(sym.model.velocities[k].clone()), Some(span.clone()));
             return;
         }

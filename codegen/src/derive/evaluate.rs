@@ -5,7 +5,7 @@
 use symbolica::evaluate::{Instruction, Slot as ESlot};
 use symbolica::prelude::*;
 
-use super::build::{constant_symbol, own_constants};
+use super::build::{constant_symbol, own_constants, own_functions, own_symbol};
 use super::coefficients;
 use crate::ir::Constant;
 use crate::program::{Func, Instr, Program, Slot};
@@ -35,10 +35,122 @@ pub fn programs(outputs: &[Atom], inputs: &[Atom], params: usize) -> Result<Vec<
     Ok(vec![plain, then])
 }
 
-/// An optimised program for `outputs` in terms of `inputs`. π and e enter
-/// as two extra inputs, which become constants of the program with their
-/// values; every constant is checked to be a finite real number.
+/// An optimised program for `outputs` in terms of `inputs`.
+///
+/// symbolica's evaluator knows sin, cos, exp and log; the functions of ours
+/// ([`own_functions`]) reach it as values: each application whose argument
+/// has none of them becomes a new input, computed before by a program of
+/// its own (the arguments, then a call of the function on each), and so on
+/// outwards through nested applications.
 pub fn program(outputs: &[Atom], inputs: &[Atom]) -> Result<Program, String> {
+    let ours: Vec<Symbol> = own_functions().collect();
+    // Applications computed so far, each with the symbol standing for it.
+    let mut known: Vec<(Atom, Symbol)> = Vec::new();
+    let replaced = |a: &Atom, known: &[(Atom, Symbol)]| {
+        // Innermost first: each was found with the earlier ones replaced.
+        known.iter().fold(a.clone(), |a, (app, s)| {
+            a.replace(app.clone()).with(Atom::from(*s))
+        })
+    };
+    let mut stage: Option<Program> = None;
+    loop {
+        let mut ready: Vec<(Atom, Func)> = Vec::new();
+        for o in outputs {
+            innermost(replaced(o, &known).as_view(), &ours, &mut ready);
+        }
+        if ready.is_empty() {
+            break;
+        }
+        let mut unique: Vec<(Atom, Func)> = Vec::new();
+        for r in ready {
+            if !unique.iter().any(|u| u.0 == r.0) {
+                unique.push(r);
+            }
+        }
+        // This stage: the values so far passed on, then each argument,
+        // each then replaced by its function's value.
+        let all_inputs: Vec<Atom> = (inputs.iter().cloned())
+            .chain(known.iter().map(|(_, s)| Atom::from(*s)))
+            .collect();
+        let mut stage_outputs: Vec<Atom> = known.iter().map(|(_, s)| Atom::from(*s)).collect();
+        stage_outputs.extend(unique.iter().map(|(app, _)| argument(app)));
+        let mut p = plain_program(&stage_outputs, &all_inputs)?;
+        for (k, (_, f)) in unique.iter().enumerate() {
+            let out = Slot::Out(known.len() + k);
+            p.instrs.push(Instr::Fun(out, *f, out));
+        }
+        stage = Some(match stage {
+            None => p,
+            Some(first) => p.fed_by(&first, inputs.len()),
+        });
+        for (app, _) in unique {
+            let s = own_symbol(&format!("call__{}", known.len()));
+            known.push((app, s));
+        }
+    }
+    let Some(first) = stage else {
+        return plain_program(outputs, inputs);
+    };
+    let all_inputs: Vec<Atom> = (inputs.iter().cloned())
+        .chain(known.iter().map(|(_, s)| Atom::from(*s)))
+        .collect();
+    let outputs: Vec<Atom> = outputs.iter().map(|o| replaced(o, &known)).collect();
+    Ok(plain_program(&outputs, &all_inputs)?.fed_by(&first, inputs.len()))
+}
+
+/// The applications of the functions `ours` in `a` whose argument has none
+/// of them, each with its function.
+fn innermost(a: AtomView, ours: &[Symbol], out: &mut Vec<(Atom, Func)>) {
+    match a {
+        AtomView::Fun(f) => {
+            let s = f.get_symbol();
+            if ours.contains(&s) && !f.iter().any(|x| contains_own(x, ours)) {
+                let func = Func::from_name(s.get_stripped_name()).expect("a function of ours");
+                out.push((a.to_owned(), func));
+            } else {
+                f.iter().for_each(|x| innermost(x, ours, out));
+            }
+        }
+        AtomView::Add(x) => x.iter().for_each(|x| innermost(x, ours, out)),
+        AtomView::Mul(x) => x.iter().for_each(|x| innermost(x, ours, out)),
+        AtomView::Pow(p) => {
+            let (b, e) = p.get_base_exp();
+            innermost(b, ours, out);
+            innermost(e, ours, out);
+        }
+        _ => {}
+    }
+}
+
+/// Whether `a` applies one of the functions `ours`.
+fn contains_own(a: AtomView, ours: &[Symbol]) -> bool {
+    match a {
+        AtomView::Fun(f) => {
+            ours.contains(&f.get_symbol()) || f.iter().any(|x| contains_own(x, ours))
+        }
+        AtomView::Add(x) => x.iter().any(|x| contains_own(x, ours)),
+        AtomView::Mul(x) => x.iter().any(|x| contains_own(x, ours)),
+        AtomView::Pow(p) => {
+            let (b, e) = p.get_base_exp();
+            contains_own(b, ours) || contains_own(e, ours)
+        }
+        _ => false,
+    }
+}
+
+/// The one argument of an application.
+fn argument(app: &Atom) -> Atom {
+    match app.as_view() {
+        AtomView::Fun(f) => f.iter().next().expect("one argument").to_owned(),
+        _ => unreachable!("an application"),
+    }
+}
+
+/// [`program`] for outputs in the functions symbolica's evaluator knows.
+/// π and e enter as two extra inputs, which become constants of the
+/// program with their values; every constant is checked to be a finite
+/// real number.
+fn plain_program(outputs: &[Atom], inputs: &[Atom]) -> Result<Program, String> {
     if outputs.is_empty() {
         return Ok(Program {
             inputs: inputs.len(),
@@ -178,6 +290,57 @@ mod tests {
                 assert!(
                     (g - w).abs() <= 1e-12 * w.abs().max(1.0),
                     "{got:?} against {want:?}"
+                );
+            }
+        }
+    }
+
+    /// The functions symbolica does not know reach the program as calls,
+    /// nested ones outwards from the innermost, each computed once; their
+    /// derivatives are written out by their rules.
+    #[test]
+    fn functions_of_ours_and_their_derivatives() {
+        use crate::derive::build::{Differentiate, own_functions};
+        crate::lock::acquire().unwrap();
+        let _ns = Namespace::enter("functions of ours test");
+        let [x, y] = ["x", "y"].map(|n| Atom::from(own_symbol(n)));
+        let [atan, asin, acos, sinh, cosh, tanh] = {
+            let v: Vec<Symbol> = own_functions().collect();
+            [v[0], v[1], v[2], v[3], v[4], v[5]]
+        };
+        let third = Atom::num(1) / Atom::num(3);
+        let e = function!(atan, function!(tanh, &x * &y) + &x)
+            + function!(asin, &x * &third) * function!(cosh, &y)
+            + function!(acos, &y * &third) * function!(sinh, &x * &x)
+            + function!(tanh, &x * &y);
+        let outputs = [e.clone(), e.d(own_symbol("x")), e.d(own_symbol("y"))];
+        let p = program(&outputs, &[x, y]).unwrap();
+        let calls = p
+            .instrs
+            .iter()
+            .filter(|i| matches!(i, Instr::Fun(_, Func::Tanh, _)))
+            .count();
+        assert_eq!(calls, 1, "tanh(xy) computed once");
+        let f = |a: f64, b: f64| {
+            ((a * b).tanh() + a).atan()
+                + (a / 3.0).asin() * b.cosh()
+                + (b / 3.0).acos() * (a * a).sinh()
+                + (a * b).tanh()
+        };
+        let h = 1e-5;
+        for (a, b) in [(0.3, 1.7), (-1.2, 0.4), (2.5, -2.0)] {
+            let got = p.eval(&[a, b]);
+            let dx = (f(a + h, b) - f(a - h, b)) / (2.0 * h);
+            let dy = (f(a, b + h) - f(a, b - h)) / (2.0 * h);
+            for (g, w, tol) in [
+                (got[0], f(a, b), 1e-14),
+                (got[1], dx, 1e-8),
+                (got[2], dy, 1e-8),
+            ] {
+                assert!(
+                    (g - w).abs() <= tol * w.abs().max(1.0),
+                    "{got:?} against {:?}",
+                    (f(a, b), dx, dy)
                 );
             }
         }

@@ -12,7 +12,7 @@ use std::sync::Arc;
 use symbolica::prelude::*;
 
 use super::budget::{self, Over};
-use super::build::{constant_symbol, own_constants, own_symbol};
+use super::build::{Differentiate, constant_symbol, own_constants, own_functions, own_symbol};
 use super::mechanics::Raw;
 use super::symbols::Symbols;
 use super::{Rat, is_zero};
@@ -57,7 +57,10 @@ impl Lowering {
         let mut seen: HashMap<String, usize> = HashMap::new();
         let mut args_by_fn: HashMap<String, (Option<Symbol>, Option<Symbol>)> = HashMap::new();
         let wildcard = symbol!("x__dalembert_arg_");
-        for f in [Symbol::SIN, Symbol::COS, Symbol::EXP, Symbol::LOG] {
+        let functions = [Symbol::SIN, Symbol::COS, Symbol::EXP, Symbol::LOG]
+            .into_iter()
+            .chain(own_functions());
+        for f in functions {
             let pattern = function!(f, Atom::from(wildcard)).to_pattern();
             for a in atoms {
                 let mut it = a.pattern_match(&pattern, None, None);
@@ -166,7 +169,7 @@ impl Lowering {
     pub fn collect_velocities(&self, sym: &Symbols, c: &Atom) -> Result<String, Over> {
         let mut terms = Vec::new();
         for (k, v) in sym.vels.iter().enumerate() {
-            let coeff = self.reduce(&c.derivative(*v))?;
+            let coeff = self.reduce(&c.d(*v))?;
             if is_zero(&coeff) {
                 continue;
             }

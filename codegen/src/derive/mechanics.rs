@@ -8,6 +8,7 @@ use std::ops::Range;
 
 use symbolica::prelude::*;
 
+use super::build::Differentiate;
 use super::lower::{self, Lowering};
 use super::symbols::Symbols;
 use super::{Field, Rat, is_zero, rows_matrix};
@@ -105,10 +106,10 @@ pub fn raw(sym: &Symbols, cx: &mut Collector) -> Result<Raw, Reported> {
     };
     let mut g = vec![vec![Atom::num(0); n]; n];
     for i in 0..n {
-        let ti = t.derivative(sym.vels[i]);
+        let ti = t.d(sym.vels[i]);
         for j in 0..n {
             g[i][j] = budget::expand(
-                &ti.derivative(sym.vels[j]),
+                &ti.d(sym.vels[j]),
                 cx,
                 &m.kinetic_energy.span,
                 "the kinetic energy",
@@ -128,7 +129,7 @@ pub fn raw(sym: &Symbols, cx: &mut Collector) -> Result<Raw, Reported> {
         let mut row = Vec::with_capacity(n);
         let mut bound = budget::Running::default();
         for q in &sym.coords {
-            let d = h.derivative(*q);
+            let d = h.d(*q);
             bound.add(&d, cx, &c.span, &what)?;
             row.push(d.expand());
         }
@@ -193,7 +194,7 @@ fn raw_wall(sym: &Symbols, cx: &mut Collector, w: &Wall) -> Result<RawWall, Repo
             let what = format!("wall `{}`'s surface", w.name);
             let mut row = vec![Atom::num(0); n];
             for (k, q) in sym.coords.iter().enumerate() {
-                row[k] = budget::expand(&f.derivative(*q), cx, &e.span, &what)?;
+                row[k] = budget::expand(&f.d(*q), cx, &e.span, &what)?;
             }
             let hessian = hessian_form(sym, &row, cx, &e.span, &what)?;
             (f, row, hessian)
@@ -229,7 +230,7 @@ fn raw_wall(sym: &Symbols, cx: &mut Collector, w: &Wall) -> Result<RawWall, Repo
 pub fn lagrangian_gradient(sym: &Symbols, raw: &Raw) -> Vec<Atom> {
     sym.coords
         .iter()
-        .map(|q| raw.t.derivative(*q) - raw.v.derivative(*q))
+        .map(|q| raw.t.d(*q) - raw.v.d(*q))
         .collect()
 }
 
@@ -249,14 +250,14 @@ fn forcing(sym: &Symbols, cx: &mut Collector, t: &Atom, v: &Atom) -> Result<Vec<
     let mut out = Vec::with_capacity(n);
     for i in 0..n {
         let q = sym.coords[i];
-        let dv = v.derivative(q);
+        let dv = v.d(q);
         v_bound.add(&dv, cx, v_span, "the potential")?;
-        let dt = t.derivative(q);
+        let dt = t.d(q);
         t_bound.add(&dt, cx, t_span, "the kinetic energy")?;
-        let ti = t.derivative(sym.vels[i]);
+        let ti = t.d(sym.vels[i]);
         let mut h = dv - dt;
         for (k, qk) in sym.coords.iter().enumerate() {
-            let d = ti.derivative(*qk);
+            let d = ti.d(*qk);
             t_bound.add(&d, cx, t_span, "the kinetic energy")?;
             h += d * sym.vel(k);
         }
@@ -287,7 +288,7 @@ fn drift(
     let mut bound = budget::Running::default();
     let rate = format!("{what}'s rate");
     for (j, qj) in sym.coords.iter().enumerate() {
-        let d = e.derivative(*qj);
+        let d = e.d(*qj);
         bound.add(&d, cx, span, &rate)?;
         c += d * sym.vel(j);
     }
@@ -309,7 +310,7 @@ fn hessian_form(
     for (k, entry) in row.iter().enumerate() {
         let mut rate = Atom::num(0);
         for (i, q) in sym.coords.iter().enumerate() {
-            let d = entry.derivative(*q);
+            let d = entry.d(*q);
             bound.add(&d, cx, span, what)?;
             rate += d * sym.vel(i);
         }

@@ -38,6 +38,8 @@ use std::ops::Range;
 
 use symbolica::prelude::*;
 
+use build::Differentiate;
+
 pub use output::{
     Choice, Derivation, Form, Function, Geometry, MotionSystem, Projection, WallDerivation,
 };
@@ -275,7 +277,7 @@ impl Blame<'_> {
         let fails = |derived: &[Atom]| evaluate::program(derived, &self.sym.inputs()).is_err();
         if let Some(v) = &model.potential {
             let mut derived = vec![raw.v.clone()];
-            derived.extend(self.sym.coords.iter().map(|q| raw.v.derivative(*q)));
+            derived.extend(self.sym.coords.iter().map(|q| raw.v.d(*q)));
             if fails(&derived) {
                 return v.span.clone();
             }

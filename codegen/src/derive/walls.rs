@@ -6,6 +6,7 @@
 use symbolica::prelude::*;
 
 use super::budget::Over;
+use super::build::Differentiate;
 use super::checks::{self, WallRows};
 use super::elimination;
 use super::lower::{self, Lowering};
@@ -414,7 +415,7 @@ fn simplified(
 
 /// Whether `e` depends on the coordinates.
 fn varies(c: &Context, e: &Atom) -> bool {
-    c.sym.coords.iter().any(|q| !is_zero(&e.derivative(*q)))
+    c.sym.coords.iter().any(|q| !is_zero(&e.d(*q)))
 }
 
 /// M = I − 2P.

@@ -50,14 +50,8 @@ enum Kind {
     RecipSqrt,
     /// libm's sincos(a): sin into d, cos into b.
     SinCos,
-    /// libm's sin.
-    Sin,
-    /// libm's cos.
-    Cos,
-    /// libm's exp.
-    Exp,
-    /// libm's log.
-    Log,
+    /// libm's function of that name.
+    Call(Func),
 }
 
 /// One operation: destination `d` and operands `a`, `b`, as its kind uses
@@ -218,14 +212,7 @@ impl Builder {
             }
             Machine::Call(f, x) => {
                 let a = self.read(*x);
-                let kind = match f {
-                    Func::Sin => Kind::Sin,
-                    Func::Cos => Kind::Cos,
-                    Func::Exp => Kind::Exp,
-                    Func::Log => Kind::Log,
-                    Func::Sqrt => unreachable!("a square root is Machine::Sqrt"),
-                };
-                self.unary(kind, a)
+                self.unary(Kind::Call(*f), a)
             }
             Machine::SinCos { x, pair, sin } => {
                 let a = self.read(*x);
@@ -352,10 +339,10 @@ impl Tape {
                 Kind::Sqrt => each!(|o| r[at(o.d)] = libm::sqrt(r[at(o.a)])),
                 Kind::RecipSqrt => each!(|o| r[at(o.d)] = 1.0 / libm::sqrt(r[at(o.a)])),
                 Kind::SinCos => each!(|o| (r[at(o.d)], r[at(o.b)]) = libm::sincos(r[at(o.a)])),
-                Kind::Sin => each!(|o| r[at(o.d)] = libm::sin(r[at(o.a)])),
-                Kind::Cos => each!(|o| r[at(o.d)] = libm::cos(r[at(o.a)])),
-                Kind::Exp => each!(|o| r[at(o.d)] = libm::exp(r[at(o.a)])),
-                Kind::Log => each!(|o| r[at(o.d)] = libm::log(r[at(o.a)])),
+                Kind::Call(f) => {
+                    let f = f.libm();
+                    each!(|o| r[at(o.d)] = f(r[at(o.a)]))
+                }
             }
         }
         for (k, &o) in self.outputs.iter().enumerate() {

@@ -49,17 +49,35 @@ pub enum Function {
     Log,
     /// square root
     Sqrt,
+    /// arctangent
+    Atan,
+    /// arcsine
+    Asin,
+    /// arccosine
+    Acos,
+    /// hyperbolic sine
+    Sinh,
+    /// hyperbolic cosine
+    Cosh,
+    /// hyperbolic tangent
+    Tanh,
 }
 
 impl Function {
     /// Every function, as the format documents them.
-    pub const ALL: [Function; 6] = [
+    pub const ALL: [Function; 12] = [
         Self::Sin,
         Self::Cos,
         Self::Tan,
         Self::Exp,
         Self::Log,
         Self::Sqrt,
+        Self::Atan,
+        Self::Asin,
+        Self::Acos,
+        Self::Sinh,
+        Self::Cosh,
+        Self::Tanh,
     ];
 
     /// Its name in model files.
@@ -71,11 +89,24 @@ impl Function {
             Self::Exp => "exp",
             Self::Log => "log",
             Self::Sqrt => "sqrt",
+            Self::Atan => "atan",
+            Self::Asin => "asin",
+            Self::Acos => "acos",
+            Self::Sinh => "sinh",
+            Self::Cosh => "cosh",
+            Self::Tanh => "tanh",
         }
     }
 
     fn from_name(name: &str) -> Option<Self> {
         Self::ALL.into_iter().find(|f| f.name() == name)
+    }
+
+    /// Every function's name, in a sentence: "sin, cos, … and tanh".
+    pub fn listed() -> String {
+        let names: Vec<&str> = Self::ALL.iter().map(|f| f.name()).collect();
+        let (last, rest) = names.split_last().expect("functions");
+        format!("{} and {last}", rest.join(", "))
     }
 }
 
@@ -394,7 +425,8 @@ impl Parser {
         let Some(f) = Function::from_name(name) else {
             return Err(ParseError {
                 message: format!(
-                    "unknown function `{name}`: models may use sin, cos, tan, exp, log and sqrt"
+                    "unknown function `{name}`: models may use {}",
+                    Function::listed()
                 ),
                 span: r,
                 limit: false,

@@ -28,8 +28,8 @@ pub use expr::{Constant, Function, Node, NodeKind};
 /// Names models may not declare: functions, constants and names the
 /// generated code uses itself.
 pub(crate) const RESERVED: &[&str] = &[
-    "sin", "cos", "tan", "exp", "log", "sqrt", "pi", "e", "i", "q", "v", "p", "out", "params",
-    "wall", "self", "Self",
+    "sin", "cos", "tan", "exp", "log", "sqrt", "atan", "asin", "acos", "sinh", "cosh", "tanh",
+    "pi", "e", "i", "q", "v", "p", "out", "params", "wall", "self", "Self",
 ];
 
 /// Rust keywords (strict and reserved, 2024 edition): not usable as names.

@@ -63,7 +63,7 @@ pub enum Machine {
         /// 1 over the root.
         reciprocal: bool,
     },
-    /// libm's sin, cos, exp or log of x (never sqrt: that is
+    /// libm's function of that name of x (never sqrt: that is
     /// [`Machine::Sqrt`]).
     Call(Func, Slot),
     /// The first of a sin/cos pair: libm's sincos(x) computes both, and
@@ -259,13 +259,7 @@ pub fn run(p: &Program, inputs: &[f64]) -> Vec<f64> {
             }
             Machine::Pow { x, e, reciprocal } => over(reciprocal, libm::pow(get(x), e)),
             Machine::Sqrt { x, reciprocal } => over(reciprocal, libm::sqrt(get(x))),
-            Machine::Call(f, x) => match f {
-                Func::Sin => libm::sin(get(x)),
-                Func::Cos => libm::cos(get(x)),
-                Func::Exp => libm::exp(get(x)),
-                Func::Log => libm::log(get(x)),
-                Func::Sqrt => unreachable!("a square root is Machine::Sqrt"),
-            },
+            Machine::Call(f, x) => f.libm()(get(x)),
             Machine::SinCos { x, pair, sin } => {
                 let both = libm::sincos(get(x));
                 pairs.insert(pair, both);

@@ -33,7 +33,7 @@ pub enum Slot {
 }
 
 /// A function a program may call.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Func {
     /// sin
     Sin,
@@ -45,19 +45,39 @@ pub enum Func {
     Log,
     /// square root (the evaluator's form of a power ½)
     Sqrt,
+    /// arctangent
+    Atan,
+    /// arcsine
+    Asin,
+    /// arccosine
+    Acos,
+    /// hyperbolic sine
+    Sinh,
+    /// hyperbolic cosine
+    Cosh,
+    /// hyperbolic tangent
+    Tanh,
 }
 
 impl Func {
+    /// Every function, in declaration order.
+    pub const ALL: [Func; 11] = [
+        Self::Sin,
+        Self::Cos,
+        Self::Exp,
+        Self::Log,
+        Self::Sqrt,
+        Self::Atan,
+        Self::Asin,
+        Self::Acos,
+        Self::Sinh,
+        Self::Cosh,
+        Self::Tanh,
+    ];
+
     /// By name.
     pub fn from_name(name: &str) -> Option<Self> {
-        Some(match name {
-            "sin" => Self::Sin,
-            "cos" => Self::Cos,
-            "exp" => Self::Exp,
-            "log" => Self::Log,
-            "sqrt" => Self::Sqrt,
-            _ => return None,
-        })
+        Self::ALL.into_iter().find(|f| f.name() == name)
     }
 
     /// Its name (also the libm function's).
@@ -68,6 +88,31 @@ impl Func {
             Self::Exp => "exp",
             Self::Log => "log",
             Self::Sqrt => "sqrt",
+            Self::Atan => "atan",
+            Self::Asin => "asin",
+            Self::Acos => "acos",
+            Self::Sinh => "sinh",
+            Self::Cosh => "cosh",
+            Self::Tanh => "tanh",
+        }
+    }
+
+    /// The libm function of that name: what the emitted code calls, and
+    /// so what every evaluation here calls.
+    pub fn libm(self) -> fn(f64) -> f64 {
+        use dalembert_runtime::libm;
+        match self {
+            Self::Sin => libm::sin,
+            Self::Cos => libm::cos,
+            Self::Exp => libm::exp,
+            Self::Log => libm::log,
+            Self::Sqrt => libm::sqrt,
+            Self::Atan => libm::atan,
+            Self::Asin => libm::asin,
+            Self::Acos => libm::acos,
+            Self::Sinh => libm::sinh,
+            Self::Cosh => libm::cosh,
+            Self::Tanh => libm::tanh,
         }
     }
 }

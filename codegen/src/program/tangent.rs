@@ -221,6 +221,41 @@ impl Tangent {
                     let over = self.emit(|d| Instr::Pow(d, y, -1));
                     self.product(vec![half, over, dx0()])
                 }
+                // d atan x = dx / (1 + x²)
+                Func::Atan => {
+                    let one = self.number(1.0);
+                    let square = self.emit(|d| Instr::Pow(d, x0, 2));
+                    let sum = self.sum(vec![one, square]);
+                    let over = self.emit(|d| Instr::Pow(d, sum, -1));
+                    self.product(vec![over, dx0()])
+                }
+                // d asin x = dx / √(1 − x²), d acos x = −dx / √(1 − x²)
+                Func::Asin | Func::Acos => {
+                    let one = self.number(1.0);
+                    let square = self.emit(|d| Instr::Pow(d, x0, 2));
+                    let rest = self.emit(|d| Instr::Sub(d, [one, square]));
+                    let over = self.emit(|d| Instr::Powf(d, rest, -0.5));
+                    let mut factors = vec![over, dx0()];
+                    if *f == Func::Acos {
+                        factors.insert(0, self.number(-1.0));
+                    }
+                    self.product(factors)
+                }
+                Func::Sinh => {
+                    let cosh = self.emit(|d| Instr::Fun(d, Func::Cosh, x0));
+                    self.product(vec![cosh, dx0()])
+                }
+                Func::Cosh => {
+                    let sinh = self.emit(|d| Instr::Fun(d, Func::Sinh, x0));
+                    self.product(vec![sinh, dx0()])
+                }
+                // d tanh x = (1 − tanh² x) dx
+                Func::Tanh => {
+                    let one = self.number(1.0);
+                    let square = self.emit(|d| Instr::Pow(d, y, 2));
+                    let rest = self.emit(|d| Instr::Sub(d, [one, square]));
+                    self.product(vec![rest, dx0()])
+                }
             },
             Instr::Assign(..) => dx0(),
         }

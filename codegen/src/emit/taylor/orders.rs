@@ -145,7 +145,10 @@ pub(super) fn factor_name(index: usize) -> proc_macro2::Ident {
 /// series works it out once, at order 0, into `inv{op}`, rather than
 /// dividing at every order (the same value, so the same bits).
 pub(super) fn order_factor(op: &Op) -> bool {
-    matches!(op, Op::Div { .. } | Op::Sqrt { .. } | Op::Log { .. })
+    matches!(
+        op,
+        Op::Div { .. } | Op::Sqrt { .. } | Op::Log { .. } | Op::Arc { .. }
+    )
 }
 
 /// Order 0: each function's value (the runtime's recurrences at order 0).
@@ -192,6 +195,25 @@ fn order_zero(d: &Ctx, t: &Transform, range: Range<usize>, solve: Option<&Solve>
             Op::SinCos { sin, cos, a } => {
                 let (s, c, a) = (series(*sin), series(*cos), series(*a));
                 quote! { (#s[0], #c[0]) = #tay::sin_cos(&#s, &#c, &#a, 0); }
+            }
+            Op::Arc {
+                dst,
+                a,
+                w,
+                f,
+                minus,
+            } => {
+                let (dst, a, w) = (series(*dst), series(*a), series(*w));
+                let f = format_ident!("{}", f.name());
+                let one = if *minus {
+                    quote! { -1.0 }
+                } else {
+                    quote! { 1.0 }
+                };
+                quote! {
+                    #dst[0] = ::dalembert_runtime::libm::#f(#a[0]);
+                    #inv = #one / #w[0];
+                }
             }
             Op::Add { .. } | Op::Scale { .. } => unreachable!("linear ops above"),
         }
@@ -323,6 +345,19 @@ fn order_k(d: &Ctx, t: &Transform, plan: &GroupPlan) -> (TokenStream, TokenStrea
                 Op::Log { dst, a } => {
                     let (dst, a) = (series(*dst), series(*a));
                     let h = history();
+                    quote! {
+                        #dst[k] = #tay::log_finish_by(&#a, #h, k, #inv);
+                        #w[k] = k as f64 * #dst[k];
+                    }
+                }
+                Op::Arc { dst, a, minus, .. } => {
+                    let (dst, a) = (series(*dst), series(*a));
+                    let h = history();
+                    let h = if *minus {
+                        quote! { -#h }
+                    } else {
+                        quote! { #h }
+                    };
                     quote! {
                         #dst[k] = #tay::log_finish_by(&#a, #h, k, #inv);
                         #w[k] = k as f64 * #dst[k];

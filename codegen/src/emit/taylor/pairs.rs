@@ -52,6 +52,7 @@ fn of_op(op: &Op, index: usize) -> Vec<History> {
         Op::Power { dst, a, alpha } => vec![History::Power { alpha, a, dst }],
         Op::Exp { dst, .. } => vec![product(W(index), S(dst))],
         Op::Log { a, .. } => vec![product(W(index), S(a))],
+        Op::Arc { w, .. } => vec![product(W(index), S(w))],
         Op::SinCos { sin, cos, .. } => {
             vec![product(W(index), S(cos)), product(W(index), S(sin))]
         }

@@ -146,5 +146,8 @@ pub(super) fn prelude(d: &Ctx, t: &Transform, plan: &Plan) -> TokenStream {
 /// Whether an op's history is weighted by j (it keeps the series j·xⱼ of
 /// the weighted operand, `w{op}`).
 fn weighted(op: &Op) -> bool {
-    matches!(op, Op::Exp { .. } | Op::Log { .. } | Op::SinCos { .. })
+    matches!(
+        op,
+        Op::Exp { .. } | Op::Log { .. } | Op::SinCos { .. } | Op::Arc { .. }
+    )
 }

@@ -168,10 +168,19 @@ pub(super) fn square(a: Sym) -> Sym {
 /// f(a).
 pub(super) fn call(f: Function, a: Sym) -> Sym {
     match (f, &a) {
-        (Function::Sin | Function::Tan | Function::Sqrt, Sym::Num(r)) if *r == ZERO => {
-            Sym::Num(ZERO)
+        (
+            Function::Sin
+            | Function::Tan
+            | Function::Sqrt
+            | Function::Atan
+            | Function::Asin
+            | Function::Sinh
+            | Function::Tanh,
+            Sym::Num(r),
+        ) if *r == ZERO => Sym::Num(ZERO),
+        (Function::Cos | Function::Exp | Function::Cosh, Sym::Num(r)) if *r == ZERO => {
+            Sym::Num(ONE)
         }
-        (Function::Cos | Function::Exp, Sym::Num(r)) if *r == ZERO => Sym::Num(ONE),
         _ => Sym::Call(f, Box::new(a)),
     }
 }
@@ -235,6 +244,18 @@ impl Sym {
                         Sym::Num(Rational { num: 1, den: 2 }),
                         pow(x, Rational { num: -1, den: 2 }),
                     ]),
+                    Function::Atan => pow(add([int(1), square(x)]), Rational { num: -1, den: 1 }),
+                    Function::Asin | Function::Acos => {
+                        let over = pow(add([int(1), neg(square(x))]), Rational { num: -1, den: 2 });
+                        if matches!(f, Function::Acos) {
+                            neg(over)
+                        } else {
+                            over
+                        }
+                    }
+                    Function::Sinh => call(Function::Cosh, x),
+                    Function::Cosh => call(Function::Sinh, x),
+                    Function::Tanh => add([int(1), neg(square(call(Function::Tanh, x)))]),
                 };
                 mul([outer, d])
             }
@@ -424,7 +445,10 @@ mod tests {
 
     #[test]
     fn derivatives_agree_with_differences() {
-        let e = read("x^3*sin(x*y) + exp(x)/(1 + x^2) - log(x)*sqrt(x) + tan(2*x)*cos(y)");
+        let e = read(
+            "x^3*sin(x*y) + exp(x)/(1 + x^2) - log(x)*sqrt(x) + tan(2*x)*cos(y) \
+             + atan(x*y) + asin(x/2)*acos(x*y/3) + sinh(x)*cosh(x*y) - tanh(3*x)",
+        );
         let d = e.derivative("x");
         let at = |x: f64| {
             e.value(&|n| if n == "x" { Some(x) } else { Some(0.7) })

@@ -201,6 +201,40 @@ impl Node {
                         }
                         (a.value.ln(), 1.0 / a.value)
                     }
+                    Function::Asin | Function::Acos if a.value.abs() > 1.0 + a.error => {
+                        return problem(format!(
+                            "{name} of {:.3e}, outside [-1, 1], which is not real",
+                            a.value
+                        ));
+                    }
+                    // At ±1 to within rounding the slope is unbounded: the
+                    // error is that of the square root it behaves as.
+                    Function::Asin | Function::Acos if a.value.abs() + a.error >= 1.0 => {
+                        let clamped = a.value.clamp(-1.0, 1.0);
+                        let v = if matches!(f, Function::Asin) {
+                            clamped.asin()
+                        } else {
+                            clamped.acos()
+                        };
+                        return Ok(Some(Approx {
+                            value: v,
+                            error: (2.0 * (a.error + EPS)).sqrt() * 2.0 + EPS * v.abs(),
+                        }));
+                    }
+                    Function::Asin => (a.value.asin(), 1.0 / (1.0 - a.value * a.value).sqrt()),
+                    Function::Acos => (a.value.acos(), 1.0 / (1.0 - a.value * a.value).sqrt()),
+                    Function::Atan => (a.value.atan(), 1.0),
+                    Function::Sinh | Function::Cosh => {
+                        let c = a.value.cosh();
+                        let v = if matches!(f, Function::Sinh) {
+                            a.value.sinh()
+                        } else {
+                            c
+                        };
+                        // |slope| ≤ cosh over the error's reach.
+                        (v, (a.value.abs() + a.error).cosh().max(c))
+                    }
+                    Function::Tanh => (a.value.tanh(), 1.0),
                     Function::Sqrt if a.value <= a.error => (0.0, 0.0),
                     Function::Sqrt => {
                         let v = a.value.sqrt();
@@ -257,6 +291,12 @@ mod tests {
             ("x/(sqrt(2)^2 - 2)", "(sqrt(2)^2 - 2)"),
             ("(1 - pi)^(1/2)*x", "(1 - pi)^(1/2)"),
             ("(-8)^(1/3)*x", "(-8)^(1/3)"),
+            ("asin(2)*y", "asin(2)"),
+            ("acos(-1 - pi/100)*y", "acos(-1 - pi/100)"),
+            ("sinh(1000)*y", "sinh(1000)"),
+            ("y/cosh(800)", "cosh(800)"),
+            ("y/tanh(0)", "tanh(0)"),
+            ("y/atan(sin(pi))", "atan(sin(pi))"),
         ] {
             let found = problem(text).unwrap_or_else(|| panic!("{text} passed"));
             assert!(found.starts_with(&format!("{part}:")), "{text}: {found}");
@@ -277,6 +317,14 @@ mod tests {
             "log(x)",
             "sqrt(-x)",
             "x/(1 - 1/3)",
+            "asin(1)*y",
+            "acos(-1)*y",
+            "y/acos(0)",
+            "asin(sin(pi/2))*y",
+            "sinh(700)*y",
+            "y/cosh(0)",
+            "y/tanh(1)",
+            "y/atan(1)",
         ] {
             assert_eq!(problem(text), None, "{text}");
         }

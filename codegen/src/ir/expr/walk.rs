@@ -45,6 +45,12 @@ impl Node {
                     Function::Exp => v.exp(),
                     Function::Log => v.ln(),
                     Function::Sqrt => v.sqrt(),
+                    Function::Atan => v.atan(),
+                    Function::Asin => v.asin(),
+                    Function::Acos => v.acos(),
+                    Function::Sinh => v.sinh(),
+                    Function::Cosh => v.cosh(),
+                    Function::Tanh => v.tanh(),
                 }
             }
         })

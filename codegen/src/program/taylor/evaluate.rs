@@ -125,6 +125,24 @@ impl Transform {
                 Op::Power { dst, a, alpha } => tay::power(get(*dst), get(*a), *alpha, k),
                 Op::Exp { dst, a } => tay::exp(get(*dst), get(*a), k),
                 Op::Log { dst, a } => tay::log(get(*dst), get(*a), k),
+                Op::Arc {
+                    dst,
+                    a,
+                    w,
+                    f,
+                    minus,
+                    ..
+                } => {
+                    let (c, a, w) = (get(*dst), get(*a), get(*w));
+                    let sign = if *minus { -1.0 } else { 1.0 };
+                    if k == 0 {
+                        f.libm()(a[0])
+                    } else {
+                        // As emitted: ln's finish on a, signed.
+                        let h = tay::weighted_history(c, w, k);
+                        tay::log_finish_by(a, sign * h, k, sign / w[0])
+                    }
+                }
             };
             let Some(Series::Temp(d)) = op.dst() else {
                 unreachable!("ops other than sin/cos write one temporary")

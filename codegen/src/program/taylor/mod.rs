@@ -88,6 +88,16 @@ pub enum Op {
     Log { dst: Series, a: Series },
     /// sin(a) and cos(a) together.
     SinCos { sin: Series, cos: Series, a: Series },
+    /// c = f(a) for an arc function, from c′·w = a′ (−a′ when `minus`)
+    /// and c₀ = f(a₀): atan with w = 1 + a², asin with w = √(1 − a²),
+    /// acos with the same w and `minus`.
+    Arc {
+        dst: Series,
+        a: Series,
+        w: Series,
+        f: Func,
+        minus: bool,
+    },
 }
 
 /// A program's Taylor transform.
@@ -279,6 +289,12 @@ impl<'a> Builder<'a> {
                     Machine::Call(f @ (Func::Sin | Func::Cos), _) => {
                         Term::Series(self.sin_cos(a, f == Func::Sin))
                     }
+                    Machine::Call(f @ (Func::Atan | Func::Asin | Func::Acos), _) => {
+                        Term::Series(self.arc(a, f))
+                    }
+                    Machine::Call(f @ (Func::Sinh | Func::Cosh | Func::Tanh), _) => {
+                        self.hyperbolic(a, f)
+                    }
                     Machine::SinCos { sin, .. } | Machine::Half { sin, .. } => {
                         Term::Series(self.sin_cos(a, sin))
                     }
@@ -300,6 +316,71 @@ impl<'a> Builder<'a> {
             }
         };
         if sin { s } else { c }
+    }
+
+    /// atan, asin or acos of series `a` ([`Op::Arc`]).
+    fn arc(&mut self, a: Series, f: Func) -> Series {
+        let one = Term::Number(constant(&mut self.numbers.consts, 1.0));
+        let square = self.times(Term::Series(a), Term::Series(a));
+        let w = if f == Func::Atan {
+            self.sum(&[one, square])
+        } else {
+            let minus_one = Term::Number(constant(&mut self.numbers.consts, -1.0));
+            let negated = self.times(square, minus_one);
+            let Term::Series(rest) = self.sum(&[one, negated]) else {
+                unreachable!("a sum with a series is a series")
+            };
+            Term::Series(self.op(|dst| Op::Sqrt { dst, a: rest }))
+        };
+        let Term::Series(w) = w else {
+            unreachable!("a sum with a series is a series")
+        };
+        self.op(|dst| Op::Arc {
+            dst,
+            a,
+            w,
+            f,
+            minus: f == Func::Acos,
+        })
+    }
+
+    /// sinh, cosh or tanh of series `a`, in exponentials: (eᵃ ∓ 1/eᵃ)/2,
+    /// and tanh a = 1 − 2/(e²ᵃ + 1), which stays finite where eᵃ does not.
+    fn hyperbolic(&mut self, a: Series, f: Func) -> Term {
+        let number = |b: &mut Self, x: f64| Term::Number(constant(&mut b.numbers.consts, x));
+        if f == Func::Tanh {
+            let two = number(self, 2.0);
+            let Term::Series(twice) = self.times(Term::Series(a), two) else {
+                unreachable!("a series times a number is a series")
+            };
+            let e = self.op(|dst| Op::Exp { dst, a: twice });
+            let one = number(self, 1.0);
+            let Term::Series(d) = self.sum(&[Term::Series(e), one]) else {
+                unreachable!("a sum with a series is a series")
+            };
+            let r = self.op(|dst| Op::Recip { dst, a: d });
+            let minus_two = number(self, -2.0);
+            let scaled = self.times(Term::Series(r), minus_two);
+            return self.sum(&[one, scaled]);
+        }
+        let e = self.op(|dst| Op::Exp { dst, a });
+        let r = self.op(|dst| Op::Recip { dst, a: e });
+        let both = self.op(|dst| Op::Add {
+            dst,
+            series: vec![
+                Summand {
+                    series: e,
+                    minus: false,
+                },
+                Summand {
+                    series: r,
+                    minus: f == Func::Sinh,
+                },
+            ],
+            numbers: Vec::new(),
+        });
+        let half = number(self, 0.5);
+        self.times(Term::Series(both), half)
     }
 
     /// Σ terms, at least one of them a series.
@@ -397,7 +478,8 @@ impl Op {
             | Op::Sqrt { dst, .. }
             | Op::Power { dst, .. }
             | Op::Exp { dst, .. }
-            | Op::Log { dst, .. } => Some(*dst),
+            | Op::Log { dst, .. }
+            | Op::Arc { dst, .. } => Some(*dst),
         }
     }
 }

@@ -103,6 +103,23 @@ pub(super) fn fold(ops: Vec<Op>, outputs: &mut [Term], consts: &[f64], minus_one
                 out.push(Op::Recip { dst, a: h });
                 held.insert(dst, (dst, negated));
             }
+            // Read as they are (an arc function's w is not odd).
+            Op::Arc {
+                dst,
+                a,
+                w,
+                f,
+                minus,
+            } => {
+                let (a, w) = (plain(a, &held, &mut out), plain(w, &held, &mut out));
+                out.push(Op::Arc {
+                    dst,
+                    a,
+                    w,
+                    f,
+                    minus,
+                });
+            }
             // Not odd functions (sin/cos, a pair of an odd and an even
             // one, too): they read the operand itself.
             mut op @ (Op::Sqrt { .. }

@@ -45,6 +45,7 @@ impl Op {
         match self {
             Op::Add { series, .. } => series.iter().map(|t| t.series).collect(),
             Op::Mul { a, b, .. } | Op::Div { a, b, .. } => vec![*a, *b],
+            Op::Arc { a, w, .. } => vec![*a, *w],
             Op::Scale { a, .. }
             | Op::Square { a, .. }
             | Op::Recip { a, .. }
@@ -74,6 +75,7 @@ impl Op {
             | Op::Exp { dst, a }
             | Op::Log { dst, a } => (*dst, *a) = (r(*dst), r(*a)),
             Op::SinCos { sin, cos, a } => (*sin, *cos, *a) = (r(*sin), r(*cos), r(*a)),
+            Op::Arc { dst, a, w, .. } => (*dst, *a, *w) = (r(*dst), r(*a), r(*w)),
         }
     }
 }
