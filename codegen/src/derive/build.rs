@@ -5,7 +5,9 @@
 //! functions), so every model name becomes a symbol in a namespace of ours
 //! ([`Namespace`]), and π and e are symbols of ours that the evaluation pass turns
 //! into their values. `tan` is built as sin/cos and `sqrt` as a power ½, so
-//! derivatives stay within the functions the emitted code evaluates. Each
+//! derivatives stay within the functions the emitted code evaluates; the
+//! functions symbolica lacks (atan, asin, acos, sinh, cosh, tanh) are
+//! functions of ours whose derivatives [`Differentiate::d`] writes out. Each
 //! division, logarithm and root is checked on the way: an expression that
 //! is undefined everywhere (`1/0`, `y/(x - x)`, `log(0)`, `sqrt(-1)`) is
 //! reported at its place instead of reaching later passes as infinity.
@@ -132,10 +134,13 @@ fn resolved(a: AtomView) -> Option<Atom> {
         }
         AtomView::Pow(p) => {
             let (b, e) = p.get_base_exp();
-            if resolved(b).is_none() && resolved(e).is_none() {
-                return None;
+            match (resolved(b), resolved(e)) {
+                (None, None) => None,
+                (rb, re) => Some(
+                    rb.unwrap_or_else(|| b.to_owned())
+                        .pow(re.unwrap_or_else(|| e.to_owned())),
+                ),
             }
-            Some(or_same(b).pow(or_same(e)))
         }
         _ => None,
     }
