@@ -1,12 +1,8 @@
 //! Golden generated files: the emitted Rust for every built-in model, as
 //! snapshots in `tests/snapshots/`. A change to the generator that changes
 //! emitted code shows up here for review. The files compared are the build
-//! script's (`OUT_DIR`), each derived in a process of its own, which
-//! `tests/reproducible.rs` checks against the model generated alone: a
-//! process that derives several models in turn may group a later model's
-//! sums and products otherwise (symbolica keeps the symbols it has seen),
-//! so snapshots taken that way changed whenever a model was added before
-//! another in file order.
+//! script's (`OUT_DIR`), which `tests/reproducible.rs` checks against each
+//! model generated alone.
 
 use std::path::Path;
 

@@ -25,22 +25,6 @@ use common::lcg;
 /// for 1e-12 over a run).
 const TOL: f64 = 0.0;
 
-/// Set in the process a model's test runs in (see [`alone`]).
-const CHILD: &str = "DALEMBERT_INTERPRETED_CHILD";
-
-/// Whether this is the process started for `test`; if not, starts it and
-/// waits for it to pass. The build script derives each model in a process
-/// of its own (`dalembert_codegen::compile_dir`), and so does each test
-/// here: symbolica's evaluator does not always give the same program for a
-/// model derived after others in one process.
-fn alone(test: &str) -> bool {
-    if std::env::var_os(CHILD).is_some() {
-        return true;
-    }
-    common::in_child(test, false, &[(CHILD, "1".as_ref())]);
-    false
-}
-
 fn derivation(module: &str) -> Derivation {
     let file = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("models")
@@ -284,12 +268,6 @@ macro_rules! interpreted_test {
     ($module:ident, $ty:ident, $q:literal, $n:literal) => {
         #[test]
         fn $module() {
-            if !alone(concat!(
-                "interpreted_agrees_with_compiled::",
-                stringify!($module)
-            )) {
-                return;
-            }
             let d = derivation(stringify!($module));
             functions_agree::<$ty, $n>(&d);
             runs_agree::<$ty, $n>(&d, Settings::default());

@@ -92,11 +92,9 @@ fn generated_code_does_not_depend_on_earlier_derivations() {
     );
 }
 
-/// Every built-in model as the build script wrote it against the same
-/// model generated alone in a process of its own: the same file. (Derived
-/// in one process after the models before it, chain_7's `forcing` came out
-/// with other groupings of its sums and products; the build script now
-/// derives each model in a process of its own.)
+/// Every built-in model as the build script wrote it (all of them in one
+/// process, in name order) against the same model generated alone in a
+/// process of its own: the same file.
 #[test]
 fn build_script_output_matches_each_model_generated_alone() {
     let files = common::model_files();
@@ -114,4 +112,57 @@ fn build_script_output_matches_each_model_generated_alone() {
         differ.is_empty(),
         "generated alone, these differ from the build script's files: {differ:?}"
     );
+}
+
+const ORDER: &str = "DALEMBERT_REPRODUCIBLE_ORDER";
+
+/// In a child: every built-in model generated in one process, in the order
+/// `DALEMBERT_REPRODUCIBLE_ORDER` names (`name`, `reverse` or `shuffled`),
+/// each file against the build script's.
+#[test]
+#[ignore = "runs only in the child process the other tests start"]
+fn generate_all_in_child() {
+    let Ok(order) = std::env::var(ORDER) else {
+        return;
+    };
+    let mut files = common::model_files();
+    match order.as_str() {
+        "name" => {}
+        "reverse" => files.reverse(),
+        "shuffled" => {
+            let mut seed = 7;
+            for i in (1..files.len()).rev() {
+                let j = (common::lcg(&mut seed) * (i + 1) as f64) as usize;
+                files.swap(i, j.min(i));
+            }
+        }
+        other => panic!("unknown order {other}"),
+    }
+    let mut differ = Vec::new();
+    for file in &files {
+        let name = file.file_stem().unwrap().to_string_lossy().into_owned();
+        let built = std::fs::read_to_string(Path::new(env!("OUT_DIR")).join(format!("{name}.rs")))
+            .unwrap_or_else(|e| panic!("{name}: the build script's file: {e}"));
+        let code = dalembert_codegen::generate(file).unwrap_or_else(|e| panic!("{e}"));
+        if code != built {
+            differ.push(name);
+        }
+    }
+    let names: Vec<_> = files
+        .iter()
+        .map(|f| f.file_stem().unwrap().to_owned())
+        .collect();
+    assert!(
+        differ.is_empty(),
+        "in order {names:?}, these differ: {differ:?}"
+    );
+}
+
+/// Every built-in model generated in one process, in name order, in
+/// reverse and in a shuffled order: each file is the one generated alone.
+#[test]
+fn one_process_in_any_order_gives_each_model_alone() {
+    for order in ["name", "reverse", "shuffled"] {
+        common::in_child("generate_all_in_child", true, &[(ORDER, order.as_ref())]);
+    }
 }

@@ -17,8 +17,7 @@ pub enum ErrorKind {
     /// The file cannot be read.
     #[error("cannot read the model file: {0}")]
     Io(String),
-    /// The model's generated file cannot be written, or the process
-    /// [`crate::compile_dir`] started to generate it failed.
+    /// The model's generated file cannot be written.
     #[error("cannot generate the model's code: {0}")]
     Generation(String),
     /// The path is not a regular file (a FIFO or a device would block the

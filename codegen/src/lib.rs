@@ -164,46 +164,15 @@ fn generation_error(model_file: &Path, why: String) -> ModelErrors {
     cx.into_errors()
 }
 
-/// Set in a process [`compile_dir`] starts for one model: the model file,
-/// and the file to write its code to.
-const ONE_MODEL: &str = "DALEMBERT_COMPILE_ONE_MODEL";
-const ONE_OUTPUT: &str = "DALEMBERT_COMPILE_ONE_OUTPUT";
-
 /// Generates every `*.toml` model in `models_dir` into `out_dir` (one file per
-/// model plus `models.rs`, which includes them all). Errors of every model are
-/// collected before returning.
+/// model plus `models.rs`, which includes them all), in this process, in
+/// name order. Errors of every model are collected before returning.
 ///
-/// Called from a build script (cargo has set `TARGET`, `HOST` and
-/// `OUT_DIR`), it derives each model in a process of its own: the build
-/// script runs again, once per model, and this call in it generates that
-/// model alone and returns (no models, or that model's errors), so the
-/// build script should do nothing after it but report its errors and exit
-/// with failure on them. symbolica's evaluator does not always give the same program for
-/// a model derived after others in one process as for the model alone
-/// (`ARCHITECTURE.md`); this way the build script's code is what
-/// `dalembert generate` writes. Elsewhere, or where a process cannot be
-/// started, the model is derived in this process. A model whose process
-/// fails is derived here for its errors; if it has none, the failure
-/// itself is the error (with the process's exit status and standard
-/// error), and no code is written for it.
+/// Each model's file is the one [`generate`] writes for it alone: a
+/// model's programs do not depend on what the process derived before
+/// (`derive/evaluate.rs` says how; `tests/reproducible.rs` derives the
+/// built-in models in several orders in one process).
 pub fn compile_dir(models_dir: &Path, out_dir: &Path) -> Result<Vec<Generated>, Vec<ModelErrors>> {
-    if let (Some(model), Some(output)) = (std::env::var_os(ONE_MODEL), std::env::var_os(ONE_OUTPUT))
-    {
-        // The process started for one model: its errors make the build
-        // script fail, which the starting process sees.
-        let (model, output) = (PathBuf::from(model), PathBuf::from(output));
-        let code = generate(&model).map_err(|e| vec![e])?;
-        if let Err(e) = std::fs::write(&output, code) {
-            return Err(vec![generation_error(
-                &model,
-                format!("{}: {e}", output.display()),
-            )]);
-        }
-        return Ok(Vec::new());
-    }
-    let build_script = ["TARGET", "HOST", "OUT_DIR"]
-        .iter()
-        .all(|v| std::env::var_os(v).is_some());
     let mut files: Vec<PathBuf> = match std::fs::read_dir(models_dir) {
         Ok(rd) => rd
             .filter_map(|e| e.ok().map(|e| e.path()))
@@ -218,9 +187,6 @@ pub fn compile_dir(models_dir: &Path, out_dir: &Path) -> Result<Vec<Generated>, 
     files.sort();
     let mut done = Vec::new();
     let mut errors = Vec::new();
-    // Models to derive here, after every process started for one has ended
-    // (this process holds symbolica's lock from its first derivation on).
-    let mut here = Vec::new();
     for file in files {
         let model = match ir::load(&file) {
             Ok(m) => m,
@@ -236,53 +202,15 @@ pub fn compile_dir(models_dir: &Path, out_dir: &Path) -> Result<Vec<Generated>, 
             q: model.coordinates.len(),
             n: model.velocities.len(),
         };
-        if !build_script {
-            here.push((model, generated, None));
-            continue;
-        }
-        let started = std::env::current_exe().and_then(|exe| {
-            std::process::Command::new(exe)
-                .env(ONE_MODEL, &generated.model_file)
-                .env(ONE_OUTPUT, &generated.rust_file)
-                .stdout(std::process::Stdio::null())
-                .stderr(std::process::Stdio::piped())
-                .output()
-        });
-        match started {
-            Ok(out) if out.status.success() => done.push(generated),
-            // Derived here only for its errors (below).
-            Ok(out) => {
-                let stderr = String::from_utf8_lossy(&out.stderr);
-                let failure = match stderr.trim() {
-                    "" => out.status.to_string(),
-                    said => format!("{}; it wrote: {said}", out.status),
-                };
-                here.push((model, generated, Some(failure)));
-            }
-            // No process could be started: derived here.
-            Err(_) => here.push((model, generated, None)),
-        }
-    }
-    for (model, generated, failed) in here {
-        let derived =
-            derive::derive(&model).and_then(|d| emittable(&d, Options::default()).map(|()| d));
-        let written = match (derived, failed) {
-            (Err(e), _) => Err(e),
-            // The model derives here, yet its own process failed: its code
-            // here could differ from what it would be alone, so it is
-            // neither emitted nor written.
-            (Ok(_), Some(failure)) => Err(generation_error(
-                &generated.model_file,
-                format!("the process started to generate it alone failed ({failure})"),
-            )),
-            (Ok(d), None) => {
+        let written = derive::derive(&model)
+            .and_then(|d| emittable(&d, Options::default()).map(|()| d))
+            .and_then(|d| {
                 let code = emit::file(&d, Options::default());
                 std::fs::write(&generated.rust_file, code).map_err(|e| {
                     let file = generated.rust_file.display();
                     generation_error(&generated.model_file, format!("{file}: {e}"))
                 })
-            }
-        };
+            });
         match written {
             Ok(()) => done.push(generated),
             Err(e) => errors.push(e),

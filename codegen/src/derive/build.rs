@@ -64,6 +64,33 @@ pub fn own_symbol(name: &str) -> Symbol {
     NAMESPACE.with(|ns| symbol!(format!("{}::{name}", ns.borrow()).as_str()))
 }
 
+/// How many places [`make_places`] makes.
+const PLACES: usize = 4096;
+
+static MADE_PLACES: std::sync::OnceLock<Vec<Symbol>> = std::sync::OnceLock::new();
+
+/// Makes the first places ([`place`]); called when a process first takes
+/// the symbolic engine's lock, before any other symbol of ours is made.
+pub fn make_places() {
+    MADE_PLACES.get_or_init(|| (0..PLACES).map(made_place).collect());
+}
+
+/// The symbol of place `i`: the symbols expressions are written in for the
+/// evaluator (`evaluate`, which says why). The first 4096 are made once per
+/// process, at the same point in every process, so that they are the same
+/// symbols everywhere; a place past them is made when first asked for, and
+/// a program that reaches one can depend on what the process made before.
+pub fn place(i: usize) -> Symbol {
+    match MADE_PLACES.get().and_then(|p| p.get(i)) {
+        Some(s) => *s,
+        None => made_place(i),
+    }
+}
+
+fn made_place(i: usize) -> Symbol {
+    symbol!(format!("dalembert_places::x{i}").as_str())
+}
+
 /// The functions of the language symbolica does not have, as functions of
 /// ours (atan, asin, acos, sinh, cosh, tanh).
 pub const OWN_FUNCTIONS: [Function; 6] = [

@@ -19,8 +19,6 @@
 
 use symbolica::prelude::*;
 
-use super::build::own_symbol;
-
 /// The outputs rewritten over named coefficients, and what each name stands
 /// for (an expression in the parameters alone).
 pub struct Named {
@@ -34,10 +32,12 @@ pub struct Named {
 }
 
 /// Names the parameter-only coefficients of `outputs`, whose varying symbols
-/// (coordinates and velocities) are `varying`.
-pub fn name(outputs: &[Atom], varying: &[Symbol]) -> Named {
+/// (coordinates and velocities) are `varying`; coefficient `k` is named
+/// `symbol(k)`.
+pub fn name(outputs: &[Atom], varying: &[Symbol], symbol: impl Fn(usize) -> Symbol) -> Named {
     let mut n = Namer {
         varying,
+        symbol: &symbol,
         named: Named {
             outputs: Vec::new(),
             symbols: Vec::new(),
@@ -51,6 +51,7 @@ pub fn name(outputs: &[Atom], varying: &[Symbol]) -> Named {
 
 struct Namer<'a> {
     varying: &'a [Symbol],
+    symbol: &'a dyn Fn(usize) -> Symbol,
     named: Named,
 }
 
@@ -157,7 +158,7 @@ impl Namer<'_> {
         if let Some(k) = named.coefficients.iter().position(|x| *x == minus) {
             return -Atom::from(named.symbols[k]);
         }
-        let s = own_symbol(&format!("k__{}", named.symbols.len()));
+        let s = (self.symbol)(named.symbols.len());
         named.symbols.push(s);
         named.coefficients.push(c);
         Atom::from(s)
@@ -167,7 +168,7 @@ impl Namer<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::derive::build::Namespace;
+    use crate::derive::build::{Namespace, own_symbol};
 
     /// The chain's G entry: two groups with one coefficient, l1 l2 (m2 + m3),
     /// and the same value as before.
@@ -192,7 +193,9 @@ mod tests {
             // and the opposite coefficient on another term
             - &l1 * &l2 * &m2 * &s2
             - &l1 * &l2 * &m3 * &s2;
-        let named = name(std::slice::from_ref(&g), &[q1, q2]);
+        let named = name(std::slice::from_ref(&g), &[q1, q2], |k| {
+            own_symbol(&format!("k__{k}"))
+        });
         assert_eq!(named.symbols.len(), 1, "{:?}", named.outputs[0]);
         let k = Atom::from(named.symbols[0]);
         let want = (&l1 * &l2 * (&m2 + &m3)).expand();

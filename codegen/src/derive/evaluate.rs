@@ -1,14 +1,40 @@
 //! Pass 5: expressions to straight-line programs by symbolica's evaluator
 //! optimisation (common subexpressions, Horner schemes), converted to the
 //! generator's own [`Program`], which later stages use without symbolica.
+//!
+//! The evaluator's program (its groupings of sums and products, not only
+//! the order of its instructions) depends on the symbols it is given, not
+//! only on the expressions' structure, and so does the order symbolica
+//! keeps the terms of a sum in, which the naming of coefficients walks: a
+//! model derived in one process after others came out with other
+//! groupings than alone. So every expression is first written in places
+//! ([`place`]): symbols made once per process, before any other symbol of
+//! ours, and the same in every process. Input `i` of a program is place
+//! `2 + i`, π and e are places 0 and 1, and what the pass names on the way
+//! (coefficients, applications of the functions of ours) takes the places
+//! after the inputs. A model's programs then depend on the model alone,
+//! whatever the process derived before.
+
+use std::collections::HashMap;
 
 use symbolica::evaluate::{Instruction, Slot as ESlot};
 use symbolica::prelude::*;
 
-use super::build::{constant_symbol, own_constants, own_functions, own_symbol};
+use super::build::{constant_symbol, own_functions, place};
 use super::coefficients;
 use crate::ir::Constant;
 use crate::program::{Func, Instr, Program, Slot};
+
+/// The place of π, and the place of e ([`place`]).
+const PI: usize = 0;
+const E: usize = 1;
+/// The place of input 0.
+const FIRST_INPUT: usize = 2;
+
+/// The places of `n` inputs.
+fn input_places(n: usize) -> Vec<Symbol> {
+    (FIRST_INPUT..FIRST_INPUT + n).map(place).collect()
+}
 
 /// Programs for `outputs` (inputs: the `params` parameters first, then
 /// the coordinates and velocities): the evaluator's over the expressions as
@@ -16,35 +42,78 @@ use crate::program::{Func, Instr, Program, Slot};
 /// over the expressions with those named ([`coefficients`]), preceded by
 /// the program of the coefficients. The caller keeps the cheaper.
 pub fn programs(outputs: &[Atom], inputs: &[Atom], params: usize) -> Result<Vec<Program>, String> {
-    let plain = program(outputs, inputs)?;
-    let varying: Vec<Symbol> = inputs[params..]
-        .iter()
-        .filter_map(|a| match a.as_view() {
-            AtomView::Var(v) => Some(v.get_symbol()),
-            _ => None,
-        })
-        .collect();
-    let named = coefficients::name(outputs, &varying);
+    let outputs = placed(outputs, inputs)?;
+    let plain = program_in_places(&outputs, inputs.len())?;
+    let places = input_places(inputs.len());
+    let first_name = FIRST_INPUT + inputs.len();
+    let named = coefficients::name(&outputs, &places[params..], |k| place(first_name + k));
     if named.symbols.is_empty() {
         return Ok(vec![plain]);
     }
-    let first = program(&named.coefficients, &inputs[..params])?;
-    let mut all_inputs = inputs.to_vec();
-    all_inputs.extend(named.symbols.iter().map(|s| Atom::from(*s)));
-    let then = program(&named.outputs, &all_inputs)?.fed_by(&first, inputs.len());
+    let first = program_in_places(&named.coefficients, params)?;
+    let all_inputs = inputs.len() + named.symbols.len();
+    let then = program_in_places(&named.outputs, all_inputs)?.fed_by(&first, inputs.len());
     Ok(vec![plain, then])
 }
 
-/// An optimised program for `outputs` in terms of `inputs`.
+/// An optimised program for `outputs` in terms of `inputs` (symbols).
+pub fn program(outputs: &[Atom], inputs: &[Atom]) -> Result<Program, String> {
+    program_in_places(&placed(outputs, inputs)?, inputs.len())
+}
+
+/// `outputs` written in places: `inputs[i]` as place `2 + i`, π and e (ours
+/// and symbolica's) as places 0 and 1.
+fn placed(outputs: &[Atom], inputs: &[Atom]) -> Result<Vec<Atom>, String> {
+    let mut to = HashMap::with_capacity(inputs.len() + 4);
+    for (input, p) in inputs.iter().zip(input_places(inputs.len())) {
+        let AtomView::Var(v) = input.as_view() else {
+            return Err(format!(
+                "an input of the evaluator is not a symbol: {input}"
+            ));
+        };
+        to.insert(v.get_symbol(), Atom::from(p));
+    }
+    for (c, ours, theirs) in [(PI, Constant::Pi, Symbol::PI), (E, Constant::E, Symbol::E)] {
+        to.insert(constant_symbol(ours), Atom::from(place(c)));
+        to.insert(theirs, Atom::from(place(c)));
+    }
+    Ok(outputs.iter().map(|o| renamed(o.as_view(), &to)).collect())
+}
+
+/// `a` with each symbol in `to` replaced by its image.
+fn renamed(a: AtomView, to: &HashMap<Symbol, Atom>) -> Atom {
+    match a {
+        AtomView::Var(v) => to
+            .get(&v.get_symbol())
+            .cloned()
+            .unwrap_or_else(|| a.to_owned()),
+        AtomView::Fun(f) => {
+            let args: Vec<Atom> = f.iter().map(|x| renamed(x, to)).collect();
+            FunctionBuilder::new(f.get_symbol())
+                .add_args(&args)
+                .finish()
+        }
+        AtomView::Add(s) => s.iter().fold(Atom::num(0), |acc, x| acc + renamed(x, to)),
+        AtomView::Mul(m) => m.iter().fold(Atom::num(1), |acc, x| acc * renamed(x, to)),
+        AtomView::Pow(p) => {
+            let (b, e) = p.get_base_exp();
+            renamed(b, to).pow(renamed(e, to))
+        }
+        _ => a.to_owned(),
+    }
+}
+
+/// An optimised program for `outputs`, written in places, in terms of the
+/// first `inputs` input places.
 ///
 /// symbolica's evaluator knows sin, cos, exp and log; the functions of ours
 /// ([`own_functions`]) reach it as values: each application whose argument
-/// has none of them becomes a new input, computed before by a program of
-/// its own (the arguments, then a call of the function on each), and so on
-/// outwards through nested applications.
-pub fn program(outputs: &[Atom], inputs: &[Atom]) -> Result<Program, String> {
+/// has none of them becomes a new input (the places after the inputs),
+/// computed before by a program of its own (the arguments, then a call of
+/// the function on each), and so on outwards through nested applications.
+fn program_in_places(outputs: &[Atom], inputs: usize) -> Result<Program, String> {
     let ours: Vec<Symbol> = own_functions().collect();
-    // Applications computed so far, each with the symbol standing for it.
+    // Applications computed so far, each with the place standing for it.
     let mut known: Vec<(Atom, Symbol)> = Vec::new();
     let replaced = |a: &Atom, known: &[(Atom, Symbol)]| {
         // Innermost first: each was found with the earlier ones replaced.
@@ -69,33 +138,27 @@ pub fn program(outputs: &[Atom], inputs: &[Atom]) -> Result<Program, String> {
         }
         // This stage: the values so far passed on, then each argument,
         // each then replaced by its function's value.
-        let all_inputs: Vec<Atom> = (inputs.iter().cloned())
-            .chain(known.iter().map(|(_, s)| Atom::from(*s)))
-            .collect();
         let mut stage_outputs: Vec<Atom> = known.iter().map(|(_, s)| Atom::from(*s)).collect();
         stage_outputs.extend(unique.iter().map(|(app, _)| argument(app)));
-        let mut p = plain_program(&stage_outputs, &all_inputs)?;
+        let mut p = plain_program(&stage_outputs, inputs + known.len())?;
         for (k, (_, f)) in unique.iter().enumerate() {
             let out = Slot::Out(known.len() + k);
             p.instrs.push(Instr::Fun(out, *f, out));
         }
         stage = Some(match stage {
             None => p,
-            Some(first) => p.fed_by(&first, inputs.len()),
+            Some(first) => p.fed_by(&first, inputs),
         });
         for (app, _) in unique {
-            let s = own_symbol(&format!("call__{}", known.len()));
+            let s = place(FIRST_INPUT + inputs + known.len());
             known.push((app, s));
         }
     }
     let Some(first) = stage else {
         return plain_program(outputs, inputs);
     };
-    let all_inputs: Vec<Atom> = (inputs.iter().cloned())
-        .chain(known.iter().map(|(_, s)| Atom::from(*s)))
-        .collect();
     let outputs: Vec<Atom> = outputs.iter().map(|o| replaced(o, &known)).collect();
-    Ok(plain_program(&outputs, &all_inputs)?.fed_by(&first, inputs.len()))
+    Ok(plain_program(&outputs, inputs + known.len())?.fed_by(&first, inputs))
 }
 
 /// The applications of the functions `ours` in `a` whose argument has none
@@ -146,24 +209,23 @@ fn argument(app: &Atom) -> Atom {
     }
 }
 
-/// [`program`] for outputs in the functions symbolica's evaluator knows.
-/// π and e enter as two extra inputs, which become constants of the
-/// program with their values; every constant is checked to be a finite
-/// real number.
-fn plain_program(outputs: &[Atom], inputs: &[Atom]) -> Result<Program, String> {
+/// [`program_in_places`] for outputs in the functions symbolica's
+/// evaluator knows. π and e (places 0 and 1) enter as two extra inputs,
+/// which become constants of the program with their values; every
+/// constant is checked to be a finite real number.
+fn plain_program(outputs: &[Atom], inputs: usize) -> Result<Program, String> {
     if outputs.is_empty() {
         return Ok(Program {
-            inputs: inputs.len(),
+            inputs,
             consts: Vec::new(),
             instrs: Vec::new(),
             outputs: 0,
         });
     }
     let constants = [Constant::Pi, Constant::E];
-    let mut all_inputs = inputs.to_vec();
-    all_inputs.extend(constants.map(|c| Atom::from(constant_symbol(c))));
-    let outputs: Vec<Atom> = outputs.iter().map(own_constants).collect();
-    let ev = Atom::evaluator_multiple(&outputs, &all_inputs)
+    let mut all_inputs: Vec<Atom> = input_places(inputs).into_iter().map(Atom::from).collect();
+    all_inputs.extend([PI, E].map(|c| Atom::from(place(c))));
+    let ev = Atom::evaluator_multiple(outputs, &all_inputs)
         .optimization_settings(OptimizationSettings::default())
         .build()
         .map_err(|e| format!("{e:?}"))?;
@@ -185,7 +247,7 @@ fn plain_program(outputs: &[Atom], inputs: &[Atom]) -> Result<Program, String> {
     let first_constant = consts.len();
     consts.extend(constants.map(Constant::value));
     let slot = |s: &ESlot| match s {
-        ESlot::Param(i) if *i >= inputs.len() => Slot::Const(first_constant + i - inputs.len()),
+        ESlot::Param(i) if *i >= inputs => Slot::Const(first_constant + i - inputs),
         ESlot::Param(i) => Slot::Input(*i),
         ESlot::Const(i) => Slot::Const(*i),
         ESlot::Temp(i) => Slot::Temp(*i),
@@ -250,7 +312,7 @@ fn plain_program(outputs: &[Atom], inputs: &[Atom]) -> Result<Program, String> {
         instrs.push(one);
     }
     Ok(Program {
-        inputs: inputs.len(),
+        inputs,
         consts,
         instrs,
         outputs: ex.output_count,

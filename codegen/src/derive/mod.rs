@@ -34,6 +34,7 @@ mod sample;
 mod symbols;
 mod walls;
 
+pub(crate) use build::make_places;
 use std::ops::Range;
 
 use symbolica::prelude::*;
