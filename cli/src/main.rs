@@ -139,8 +139,10 @@ fn notices_to_stderr<T>(f: impl FnOnce() -> T) -> T {
 
 /// `derive`: the derivation, then how long derivation and emission took.
 fn derive_timed(file: &Path) -> Result<bool, String> {
-    // Waiting for another process's use of the engine is not derivation time.
-    dalembert_codegen::lock::acquire()?;
+    // Waiting for another process's use of the engine is not derivation
+    // time. Taking the lock makes the generator's first symbols, which can
+    // show symbolica's notice.
+    notices_to_stderr(dalembert_codegen::lock::acquire)?;
     let start = std::time::Instant::now();
     let d = derive(file)?;
     let derived = start.elapsed();
