@@ -18,6 +18,7 @@ use std::ops::Range;
 
 use symbolica::prelude::*;
 
+use crate::ir::expr::derivative::{Algebra, derivative};
 use crate::ir::{Constant, Function, Node, NodeKind, Rational};
 
 thread_local! {
@@ -173,19 +174,52 @@ fn resolved(a: AtomView) -> Option<Atom> {
     }
 }
 
-/// f′(z) for a function of ours, in the functions the language has.
+/// f′(z) for a function of ours, by the language's rule
+/// ([`derivative`]).
 fn derivative_rule(f: Function, z: Atom) -> Atom {
-    let one = Atom::num(1);
-    let square = z.clone().pow(Atom::num(2));
-    let half = Atom::num(1) / Atom::num(2);
+    let y = applied(f, z.clone());
+    let factors = derivative(&mut Atoms, f, z, y);
+    factors.into_iter().fold(Atom::num(1), |acc, x| acc * x)
+}
+
+/// symbolica's expressions as the derivative rules' algebra.
+struct Atoms;
+
+impl Algebra for Atoms {
+    type E = Atom;
+    fn number(&mut self, num: i64, den: i64) -> Atom {
+        Atom::num(num) / Atom::num(den)
+    }
+    fn add(&mut self, terms: Vec<Atom>) -> Atom {
+        terms.into_iter().fold(Atom::num(0), |acc, t| acc + t)
+    }
+    fn sub(&mut self, a: Atom, b: Atom) -> Atom {
+        a - b
+    }
+    fn pow(&mut self, x: Atom, num: i64, den: i64) -> Atom {
+        x.pow(Atom::num(num) / Atom::num(den))
+    }
+    fn call(&mut self, f: Function, x: Atom) -> Atom {
+        applied(f, x)
+    }
+}
+
+/// `f(x)` in symbolica's terms: tan as sin/cos, a root as a power ½, the
+/// functions symbolica lacks as functions of ours.
+fn applied(f: Function, x: Atom) -> Atom {
     match f {
-        Function::Atan => (one + square).pow(Atom::num(-1)),
-        Function::Asin => (one - square).pow(-half),
-        Function::Acos => -(one - square).pow(-half),
-        Function::Sinh => function!(own_symbol(Function::Cosh.name()), z),
-        Function::Cosh => function!(own_symbol(Function::Sinh.name()), z),
-        Function::Tanh => one - function!(own_symbol(Function::Tanh.name()), z).pow(Atom::num(2)),
-        _ => unreachable!("symbolica differentiates its own functions"),
+        Function::Sin => function!(Symbol::SIN, x),
+        Function::Cos => function!(Symbol::COS, x),
+        Function::Tan => function!(Symbol::SIN, x.clone()) / function!(Symbol::COS, x),
+        Function::Exp => function!(Symbol::EXP, x),
+        Function::Log => function!(Symbol::LOG, x),
+        Function::Sqrt => x.pow(Atom::num(1) / Atom::num(2)),
+        Function::Atan
+        | Function::Asin
+        | Function::Acos
+        | Function::Sinh
+        | Function::Cosh
+        | Function::Tanh => function!(own_symbol(f.name()), x),
     }
 }
 
@@ -275,34 +309,19 @@ pub fn build(node: &Node, definitions: &HashMap<String, Atom>) -> Result<Atom, B
         NodeKind::Call(f, x) => {
             let arg = build(x, definitions)?;
             match f {
-                Function::Sin => function!(Symbol::SIN, arg),
-                Function::Cos => function!(Symbol::COS, arg),
-                Function::Tan => function!(Symbol::SIN, arg.clone()) / function!(Symbol::COS, arg),
-                Function::Exp => function!(Symbol::EXP, arg),
-                Function::Log => {
-                    if arg.is_zero() || negative_number(&arg) {
-                        return Err(fail(
-                            "the logarithm of a number ≤ 0 is not real",
-                            &node.span,
-                        ));
-                    }
-                    function!(Symbol::LOG, arg)
+                Function::Log if arg.is_zero() || negative_number(&arg) => {
+                    return Err(fail(
+                        "the logarithm of a number ≤ 0 is not real",
+                        &node.span,
+                    ));
                 }
-                Function::Sqrt => {
-                    if negative_number(&arg) {
-                        return Err(fail(
-                            "the square root of a negative number is not real",
-                            &node.span,
-                        ));
-                    }
-                    arg.pow(Atom::num(1) / Atom::num(2))
+                Function::Sqrt if negative_number(&arg) => {
+                    return Err(fail(
+                        "the square root of a negative number is not real",
+                        &node.span,
+                    ));
                 }
-                Function::Atan
-                | Function::Asin
-                | Function::Acos
-                | Function::Sinh
-                | Function::Cosh
-                | Function::Tanh => function!(own_symbol(f.name()), arg),
+                _ => applied(*f, arg),
             }
         }
     })

@@ -80,6 +80,24 @@ impl Function {
         Self::Tanh,
     ];
 
+    /// Its value at `x` (f64, the standard library's).
+    pub fn value(self, x: f64) -> f64 {
+        match self {
+            Self::Sin => x.sin(),
+            Self::Cos => x.cos(),
+            Self::Tan => x.tan(),
+            Self::Exp => x.exp(),
+            Self::Log => x.ln(),
+            Self::Sqrt => x.sqrt(),
+            Self::Atan => x.atan(),
+            Self::Asin => x.asin(),
+            Self::Acos => x.acos(),
+            Self::Sinh => x.sinh(),
+            Self::Cosh => x.cosh(),
+            Self::Tanh => x.tanh(),
+        }
+    }
+
     /// Its name in model files.
     pub fn name(self) -> &'static str {
         match self {
@@ -98,7 +116,8 @@ impl Function {
         }
     }
 
-    fn from_name(name: &str) -> Option<Self> {
+    /// By its name in model files.
+    pub fn from_name(name: &str) -> Option<Self> {
         Self::ALL.into_iter().find(|f| f.name() == name)
     }
 
@@ -552,6 +571,7 @@ fn constant_value(node: &Node) -> Result<Rational, ParseError> {
 }
 
 mod constant;
+pub(crate) mod derivative;
 mod walk;
 pub(crate) use walk::multinomial;
 

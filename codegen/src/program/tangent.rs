@@ -1,7 +1,8 @@
 //! Forward-mode differentiation of a program: its tangent program computes
 //! the outputs and their directional derivatives along a direction given as
 //! extra inputs, one per differentiated input (a Jacobian–vector product).
-//! Each operation's derivative rule is here, once; the back ends run the
+//! Each instruction's derivative rule is here, once, and the functions'
+//! are the language's (`ir/expr/derivative.rs`); the back ends run the
 //! tangent program like any other, and a Jacobian is its columns.
 //!
 //! The cost is a small multiple of the program's: each instruction adds at
@@ -11,6 +12,8 @@
 use std::collections::HashMap;
 
 use super::{Func, Instr, Program, Slot, constant};
+use crate::ir::Function;
+use crate::ir::expr::derivative::{Algebra, derivative};
 
 impl Program {
     /// The tangent program along the inputs `from..self.inputs`: its inputs
@@ -201,63 +204,48 @@ impl Tangent {
                     self.product(vec![coefficient, power, dx0()])
                 }
             }
-            Instr::Fun(_, f, _) => match f {
-                Func::Sin => {
-                    let cos = self.emit(|d| Instr::Fun(d, Func::Cos, x0));
-                    self.product(vec![cos, dx0()])
-                }
-                Func::Cos => {
-                    let sin = self.emit(|d| Instr::Fun(d, Func::Sin, x0));
-                    let minus = self.number(-1.0);
-                    self.product(vec![minus, sin, dx0()])
-                }
-                Func::Exp => self.product(vec![y, dx0()]),
-                Func::Log => {
-                    let over = self.emit(|d| Instr::Pow(d, x0, -1));
-                    self.product(vec![over, dx0()])
-                }
-                Func::Sqrt => {
-                    let half = self.number(0.5);
-                    let over = self.emit(|d| Instr::Pow(d, y, -1));
-                    self.product(vec![half, over, dx0()])
-                }
-                // d atan x = dx / (1 + x²)
-                Func::Atan => {
-                    let one = self.number(1.0);
-                    let square = self.emit(|d| Instr::Pow(d, x0, 2));
-                    let sum = self.sum(vec![one, square]);
-                    let over = self.emit(|d| Instr::Pow(d, sum, -1));
-                    self.product(vec![over, dx0()])
-                }
-                // d asin x = dx / √(1 − x²), d acos x = −dx / √(1 − x²)
-                Func::Asin | Func::Acos => {
-                    let one = self.number(1.0);
-                    let square = self.emit(|d| Instr::Pow(d, x0, 2));
-                    let rest = self.emit(|d| Instr::Sub(d, [one, square]));
-                    let over = self.emit(|d| Instr::Powf(d, rest, -0.5));
-                    let mut factors = vec![over, dx0()];
-                    if *f == Func::Acos {
-                        factors.insert(0, self.number(-1.0));
-                    }
-                    self.product(factors)
-                }
-                Func::Sinh => {
-                    let cosh = self.emit(|d| Instr::Fun(d, Func::Cosh, x0));
-                    self.product(vec![cosh, dx0()])
-                }
-                Func::Cosh => {
-                    let sinh = self.emit(|d| Instr::Fun(d, Func::Sinh, x0));
-                    self.product(vec![sinh, dx0()])
-                }
-                // d tanh x = (1 − tanh² x) dx
-                Func::Tanh => {
-                    let one = self.number(1.0);
-                    let square = self.emit(|d| Instr::Pow(d, y, 2));
-                    let rest = self.emit(|d| Instr::Sub(d, [one, square]));
-                    self.product(vec![rest, dx0()])
-                }
-            },
+            // The language's rule (`ir::expr::derivative`), times dx.
+            Instr::Fun(_, f, _) => {
+                let f = Function::from_name(f.name()).expect("a function of the language");
+                let mut factors = derivative(self, f, x0, y);
+                factors.push(dx0());
+                self.product(factors)
+            }
             Instr::Assign(..) => dx0(),
+        }
+    }
+}
+
+/// Program values as the derivative rules' algebra: each operation an
+/// instruction (computed once, [`Tangent::emit`]).
+impl Algebra for Tangent {
+    type E = Slot;
+    fn number(&mut self, num: i64, den: i64) -> Slot {
+        self.number(num as f64 / den as f64)
+    }
+    fn add(&mut self, terms: Vec<Slot>) -> Slot {
+        self.sum(terms)
+    }
+    fn sub(&mut self, a: Slot, b: Slot) -> Slot {
+        self.emit(|d| Instr::Sub(d, [a, b]))
+    }
+    fn pow(&mut self, x: Slot, num: i64, den: i64) -> Slot {
+        if den == 1 {
+            self.emit(|d| Instr::Pow(d, x, num))
+        } else {
+            self.emit(|d| Instr::Powf(d, x, num as f64 / den as f64))
+        }
+    }
+    fn call(&mut self, f: Function, x: Slot) -> Slot {
+        match Func::from_name(f.name()) {
+            Some(func) => self.emit(|d| Instr::Fun(d, func, x)),
+            // tan, which programs write as sin/cos
+            None => {
+                let sin = self.emit(|d| Instr::Fun(d, Func::Sin, x));
+                let cos = self.emit(|d| Instr::Fun(d, Func::Cos, x));
+                let over = self.emit(|d| Instr::Pow(d, cos, -1));
+                self.product(vec![sin, over])
+            }
         }
     }
 }

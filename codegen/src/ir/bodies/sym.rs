@@ -7,6 +7,7 @@
 use std::fmt;
 
 use super::super::Rational;
+use super::super::expr::derivative::{Algebra, derivative};
 use super::super::expr::{Constant, Function, Node, NodeKind};
 use super::super::number::{checked_add, checked_mul, checked_pow};
 use std::collections::HashMap;
@@ -185,6 +186,30 @@ pub(super) fn call(f: Function, a: Sym) -> Sym {
     }
 }
 
+/// The trees as the derivative rules' algebra.
+struct Trees;
+
+impl Algebra for Trees {
+    type E = Sym;
+    fn number(&mut self, num: i64, den: i64) -> Sym {
+        let (num, den) = (i128::from(num), i128::from(den));
+        Sym::Num(Rational { num, den })
+    }
+    fn add(&mut self, terms: Vec<Sym>) -> Sym {
+        add(terms)
+    }
+    fn sub(&mut self, a: Sym, b: Sym) -> Sym {
+        sub(a, b)
+    }
+    fn pow(&mut self, x: Sym, num: i64, den: i64) -> Sym {
+        let (num, den) = (i128::from(num), i128::from(den));
+        pow(x, Rational { num, den })
+    }
+    fn call(&mut self, f: Function, x: Sym) -> Sym {
+        call(f, x)
+    }
+}
+
 impl Sym {
     /// Whether it is the number 0.
     pub(super) fn is_zero(&self) -> bool {
@@ -234,30 +259,10 @@ impl Sym {
                     return d;
                 }
                 let x = (**x).clone();
-                let outer = match f {
-                    Function::Sin => call(Function::Cos, x),
-                    Function::Cos => neg(call(Function::Sin, x)),
-                    Function::Tan => add([int(1), square(call(Function::Tan, x))]),
-                    Function::Exp => call(Function::Exp, x),
-                    Function::Log => pow(x, Rational { num: -1, den: 1 }),
-                    Function::Sqrt => mul([
-                        Sym::Num(Rational { num: 1, den: 2 }),
-                        pow(x, Rational { num: -1, den: 2 }),
-                    ]),
-                    Function::Atan => pow(add([int(1), square(x)]), Rational { num: -1, den: 1 }),
-                    Function::Asin | Function::Acos => {
-                        let over = pow(add([int(1), neg(square(x))]), Rational { num: -1, den: 2 });
-                        if matches!(f, Function::Acos) {
-                            neg(over)
-                        } else {
-                            over
-                        }
-                    }
-                    Function::Sinh => call(Function::Cosh, x),
-                    Function::Cosh => call(Function::Sinh, x),
-                    Function::Tanh => add([int(1), neg(square(call(Function::Tanh, x)))]),
-                };
-                mul([outer, d])
+                let y = call(*f, x.clone());
+                let mut factors = derivative(&mut Trees, *f, x, y);
+                factors.push(d);
+                mul(factors)
             }
         }
     }

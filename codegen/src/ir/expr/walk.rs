@@ -36,23 +36,7 @@ impl Node {
                 Some(if *divide { acc / v } else { acc * v })
             })?,
             NodeKind::Pow(x, n) => x.value(lookup)?.powf(n.to_f64()),
-            NodeKind::Call(f, x) => {
-                let v = x.value(lookup)?;
-                match f {
-                    Function::Sin => v.sin(),
-                    Function::Cos => v.cos(),
-                    Function::Tan => v.tan(),
-                    Function::Exp => v.exp(),
-                    Function::Log => v.ln(),
-                    Function::Sqrt => v.sqrt(),
-                    Function::Atan => v.atan(),
-                    Function::Asin => v.asin(),
-                    Function::Acos => v.acos(),
-                    Function::Sinh => v.sinh(),
-                    Function::Cosh => v.cosh(),
-                    Function::Tanh => v.tanh(),
-                }
-            }
+            NodeKind::Call(f, x) => f.value(x.value(lookup)?),
         })
     }
 
