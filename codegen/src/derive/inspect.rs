@@ -31,7 +31,7 @@ fn atom_with(text: &str, definitions: &HashMap<String, Atom>) -> Result<Atom, St
 
 /// Whether two expressions (in the model's names) are equal as rational
 /// functions of the names and the function applications, sin² + cos² = 1
-/// taken into account.
+/// and cosh² − sinh² = 1 taken into account.
 pub fn same(a: &str, b: &str) -> Result<bool, String> {
     same_with(a, b, &[])
 }

@@ -1,7 +1,7 @@
 //! Pass 3: function applications lowered to symbols, so that every entry of
 //! G, A and B is a rational function of symbols and exact linear algebra
-//! applies; sin² + cos² = 1 reduced; the functions raised back before
-//! evaluation.
+//! applies; sin² + cos² = 1 and cosh² − sinh² = 1 reduced; the functions
+//! raised back before evaluation.
 //!
 //! A [`Lowering`] is made only from the whole [`Raw`] derivation, so no
 //! expression that is later turned into a rational function can miss it.
@@ -16,7 +16,7 @@ use super::build::{Differentiate, constant_symbol, own_constants, own_functions,
 use super::mechanics::Raw;
 use super::symbols::Symbols;
 use super::{Rat, is_zero};
-use crate::ir::Constant;
+use crate::ir::{Constant, Function};
 
 /// A function application replaced by a symbol while matrices are computed.
 struct Lowered {
@@ -24,19 +24,28 @@ struct Lowered {
     function: Atom,
 }
 
+/// The symbols of sin and cos (`sign` −1: c² = 1 − s²), or of sinh and
+/// cosh (`sign` +1: c² = 1 + s²), of one argument.
+#[derive(Clone, Copy)]
+struct Pair {
+    s: Symbol,
+    c: Symbol,
+    sign: i64,
+}
+
 /// The lowered function applications of one model and the variables of its
 /// rational functions.
 pub struct Lowering {
     lowered: Vec<Lowered>,
-    /// (sin symbol, cos symbol) of the same argument.
-    trig_pairs: Vec<(Symbol, Symbol)>,
+    /// Pairs of one argument whose squares are tied ([`Pair`]).
+    pairs: Vec<Pair>,
     vars: Arc<Vec<PolyVariable>>,
 }
 
 impl Lowering {
     /// Finds every application of a model function in `raw` and gives it a
-    /// symbol; sin and cos of the same argument are paired for the
-    /// reduction.
+    /// symbol; sin and cos, and sinh and cosh, of the same argument are
+    /// paired for the reduction.
     pub fn new(sym: &Symbols, raw: &Raw) -> Self {
         let atoms: Vec<Atom> = raw.expressions().into_iter().map(own_constants).collect();
         let mut base: Vec<Symbol> = sym
@@ -55,52 +64,54 @@ impl Lowering {
     fn of(atoms: &[Atom], base: Vec<Symbol>) -> Self {
         let mut lowered: Vec<Lowered> = Vec::new();
         let mut seen: HashMap<String, usize> = HashMap::new();
-        let mut args_by_fn: HashMap<String, (Option<Symbol>, Option<Symbol>)> = HashMap::new();
-        let wildcard = symbol!("x__dalembert_arg_");
+        // The pairs' symbols by argument: sin, cos, sinh, cosh.
+        let mut args_by_fn: HashMap<String, [Option<Symbol>; 4]> = HashMap::new();
+        let [sinh, cosh] = [Function::Sinh, Function::Cosh].map(|f| own_symbol(f.name()));
         let functions = [Symbol::SIN, Symbol::COS, Symbol::EXP, Symbol::LOG]
             .into_iter()
             .chain(own_functions());
         for f in functions {
-            let pattern = function!(f, Atom::from(wildcard)).to_pattern();
             for a in atoms {
-                let mut it = a.pattern_match(&pattern, None, None);
-                while let Some(found) = it.next_detailed() {
-                    for (_, v) in found.match_stack {
-                        let Match::Single(arg) = v else { continue };
-                        let arg = arg.to_owned();
-                        let app = function!(f, arg.clone());
-                        let key = app.to_string();
-                        if seen.contains_key(&key) {
-                            continue;
-                        }
-                        let s = own_symbol(&format!("fn__{}", lowered.len()));
-                        seen.insert(key, lowered.len());
-                        lowered.push(Lowered {
-                            symbol: s,
-                            function: app,
-                        });
-                        let pair = args_by_fn.entry(arg.to_string()).or_default();
-                        if f == Symbol::SIN {
-                            pair.0 = Some(s);
-                        } else if f == Symbol::COS {
-                            pair.1 = Some(s);
-                        }
+                let mut found = Vec::new();
+                applications(a.as_view(), f, &mut found);
+                for arg in found {
+                    let app = function!(f, arg.clone());
+                    let key = app.to_string();
+                    if seen.contains_key(&key) {
+                        continue;
+                    }
+                    let s = own_symbol(&format!("fn__{}", lowered.len()));
+                    seen.insert(key, lowered.len());
+                    lowered.push(Lowered {
+                        symbol: s,
+                        function: app,
+                    });
+                    let place = [Symbol::SIN, Symbol::COS, sinh, cosh]
+                        .iter()
+                        .position(|g| *g == f);
+                    if let Some(k) = place {
+                        args_by_fn.entry(arg.to_string()).or_default()[k] = Some(s);
                     }
                 }
             }
         }
-        let mut trig_pairs: Vec<(Symbol, Symbol)> = args_by_fn
-            .into_values()
-            .filter_map(|(s, c)| Some((s?, c?)))
-            .collect();
-        trig_pairs.sort_by_key(|(s, _)| s.to_string());
+        let mut pairs: Vec<Pair> = Vec::new();
+        for [sin, cos, sinh, cosh] in args_by_fn.into_values() {
+            if let (Some(s), Some(c)) = (sin, cos) {
+                pairs.push(Pair { s, c, sign: -1 });
+            }
+            if let (Some(s), Some(c)) = (sinh, cosh) {
+                pairs.push(Pair { s, c, sign: 1 });
+            }
+        }
+        pairs.sort_by_key(|p| p.s.to_string());
         let mut vars: Vec<PolyVariable> = base.into_iter().map(PolyVariable::Symbol).collect();
         for l in &lowered {
             vars.push(PolyVariable::Symbol(l.symbol));
         }
         Self {
             lowered,
-            trig_pairs,
+            pairs,
             vars: Arc::new(vars),
         }
     }
@@ -127,14 +138,25 @@ impl Lowering {
     }
 
     /// `a` as a rational function of the model's symbols and the lowered
-    /// function applications.
-    pub fn to_rat(&self, a: &Atom) -> Rat {
-        self.rat(&self.lower(a))
+    /// function applications; zero where it vanishes by sin² + cos² = 1 or
+    /// cosh² − sinh² = 1 ([`Over`] where that test is past the budget).
+    ///
+    /// The exact linear algebra works with rational functions of sin and
+    /// cos as independent symbols: an entry such as cos² + sin² − 1, left
+    /// as it is, would be a pivot, and what is computed from it would
+    /// divide by zero.
+    pub fn to_rat(&self, a: &Atom) -> Result<Rat, Over> {
+        let r = self.rat(&self.lower(a));
+        if !self.pairs.is_empty() && is_zero(&self.reduce_trig(&r.numerator.to_expression())?) {
+            return Ok(self.rat(&Atom::num(0)));
+        }
+        Ok(r)
     }
 
-    /// Reduces a polynomial modulo c² + s² − 1 for every sin/cos pair:
-    /// each cⁿ (n ≥ 2) becomes c^(n mod 2)·(1 − s²)^⌊n/2⌋ at once, then the
-    /// polynomial is expanded again. (Taking two powers of c per round of
+    /// Reduces a polynomial modulo c² + s² − 1 for every sin/cos pair and
+    /// c² − s² − 1 for every sinh/cosh pair: each cⁿ (n ≥ 2) becomes
+    /// c^(n mod 2)·(1 ∓ s²)^⌊n/2⌋ at once, then the polynomial is expanded
+    /// again. (Taking two powers of c per round of
     /// rewriting and expanding, cos(x)¹⁰⁰·cos(y)¹⁰⁰·cos(z)¹⁰⁰ in T took 49
     /// expansions of a growing polynomial per entry and ran past 120 s.)
     ///
@@ -143,15 +165,16 @@ impl Lowering {
     /// expanded: [`Over`] past it.
     fn reduce_trig(&self, a: &Atom) -> Result<Atom, Over> {
         let mut a = a.expand();
-        for (s, c) in &self.trig_pairs {
-            let folded = fold_cos(a.as_view(), *c, *s);
+        for p in &self.pairs {
+            let folded = fold_cos(a.as_view(), p);
             budget::check(budget::expansion_terms(&folded))?;
             a = folded.expand();
         }
         Ok(a)
     }
 
-    /// A rational function in lowest terms, sin² + cos² = 1 reduced,
+    /// A rational function in lowest terms, sin² + cos² = 1 and
+    /// cosh² − sinh² = 1 reduced,
     /// functions raised; [`Over`] where the reduction is past the budget.
     pub fn simplify(&self, r: &Rat) -> Result<Atom, Over> {
         let num = self.reduce_trig(&r.numerator.to_expression())?;
@@ -162,7 +185,7 @@ impl Lowering {
 
     /// [`Lowering::simplify`] of an expression.
     pub fn reduce(&self, a: &Atom) -> Result<Atom, Over> {
-        self.simplify(&self.to_rat(a))
+        self.simplify(&self.to_rat(a)?)
     }
 
     /// v⁺ component printed as a combination of the velocities.
@@ -197,8 +220,8 @@ pub fn reduced(what: &str) -> String {
 }
 
 /// Whether `a` is zero as a rational function of its symbols and function
-/// applications, sin² + cos² = 1 reduced; [`Over`] where the reduction is
-/// past the budget.
+/// applications, sin² + cos² = 1 and cosh² − sinh² = 1 reduced; [`Over`]
+/// where the reduction is past the budget.
 pub fn vanishes(a: &Atom) -> Result<bool, Over> {
     let a = own_constants(a);
     let low = Lowering::of(std::slice::from_ref(&a), Vec::new());
@@ -207,9 +230,33 @@ pub fn vanishes(a: &Atom) -> Result<bool, Over> {
     Ok(is_zero(&numerator))
 }
 
-/// `a` with every power cⁿ (n ≥ 2, an integer) of the symbol `c` written
-/// as c^(n mod 2)·(1 − s²)^⌊n/2⌋, the rest as it is.
-fn fold_cos(a: AtomView, c: Symbol, s: Symbol) -> Atom {
+/// The arguments of the applications of `f` (one argument each) in `a`,
+/// each application before those inside it.
+fn applications(a: AtomView, f: Symbol, out: &mut Vec<Atom>) {
+    match a {
+        AtomView::Fun(g) => {
+            if g.get_symbol() == f
+                && let [arg] = g.iter().collect::<Vec<_>>()[..]
+            {
+                out.push(arg.to_owned());
+            }
+            g.iter().for_each(|x| applications(x, f, out));
+        }
+        AtomView::Add(x) => x.iter().for_each(|x| applications(x, f, out)),
+        AtomView::Mul(x) => x.iter().for_each(|x| applications(x, f, out)),
+        AtomView::Pow(p) => {
+            let (b, e) = p.get_base_exp();
+            applications(b, f, out);
+            applications(e, f, out);
+        }
+        AtomView::Var(_) | AtomView::Num(_) => {}
+    }
+}
+
+/// `a` with every power cⁿ (n ≥ 2, an integer) of the pair's symbol `c`
+/// written as c^(n mod 2)·(1 ± s²)^⌊n/2⌋, the rest as it is.
+fn fold_cos(a: AtomView, pair: &Pair) -> Atom {
+    let Pair { s, c, sign } = *pair;
     match a {
         AtomView::Pow(p) => {
             let (b, e) = p.get_base_exp();
@@ -218,14 +265,14 @@ fn fold_cos(a: AtomView, c: Symbol, s: Symbol) -> Atom {
                 && let Ok(n) = e.to_string().parse::<u32>()
                 && n >= 2
             {
-                let rest = Atom::num(1) - Atom::from(s).pow(Atom::num(2));
+                let rest = Atom::num(1) + Atom::num(sign) * Atom::from(s).pow(Atom::num(2));
                 return Atom::from(c).pow(Atom::num(i64::from(n % 2)))
                     * rest.pow(Atom::num(i64::from(n / 2)));
             }
-            fold_cos(b, c, s).pow(fold_cos(e, c, s))
+            fold_cos(b, pair).pow(fold_cos(e, pair))
         }
-        AtomView::Mul(m) => m.iter().fold(Atom::num(1), |p, x| p * fold_cos(x, c, s)),
-        AtomView::Add(t) => sum(t.iter().map(|x| fold_cos(x, c, s)).collect()),
+        AtomView::Mul(m) => m.iter().fold(Atom::num(1), |p, x| p * fold_cos(x, pair)),
+        AtomView::Add(t) => sum(t.iter().map(|x| fold_cos(x, pair)).collect()),
         AtomView::Fun(_) | AtomView::Var(_) | AtomView::Num(_) => a.to_owned(),
     }
 }
@@ -239,6 +286,37 @@ fn sum(mut terms: Vec<Atom>) -> Atom {
         n => {
             let right = terms.split_off(n / 2);
             sum(terms) + sum(right)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::inspect::same;
+
+    /// Zero only by sin² + cos² = 1 or cosh² − sinh² = 1, powers
+    /// included; and near misses that are not zero.
+    #[test]
+    fn squares_of_pairs_reduce() {
+        for (a, b) in [
+            ("sin(x)^2 + cos(x)^2", "1"),
+            ("cosh(x)^2 - sinh(x)^2", "1"),
+            ("cosh(x)^4 - sinh(x)^4", "cosh(x)^2 + sinh(x)^2"),
+            ("y*cosh(2*x)^3", "y*cosh(2*x)*(1 + sinh(2*x)^2)"),
+            ("y*cos(2*x)^3", "y*cos(2*x)*(1 - sin(2*x)^2)"),
+            ("y*cosh(x)^3", "y*cosh(x)*(1 + sinh(x)^2)"),
+            ("cosh(2*x)^2", "1 + sinh(2*x)^2"),
+            ("(cosh(x)^2 - sinh(x)^2)*sin(y)^2", "1 - cos(y)^2"),
+        ] {
+            assert_eq!(same(a, b), Ok(true), "{a} = {b}");
+        }
+        for (a, b) in [
+            ("cosh(x)^2 + sinh(x)^2", "1"),
+            ("cosh(x)^2 - sinh(y)^2", "1"),
+            ("cosh(x)^2 - sin(x)^2", "1"),
+            ("cos(x)^2 - sinh(x)^2", "1"),
+        ] {
+            assert_eq!(same(a, b), Ok(false), "{a} ≠ {b}");
         }
     }
 }

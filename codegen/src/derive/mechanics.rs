@@ -342,7 +342,10 @@ pub fn exact(
 ) -> Result<Exact, Reported> {
     let m = sym.model;
     let n = m.velocities.len();
-    let g_rat: Vec<Rat> = raw.g.iter().flatten().map(|a| low.to_rat(a)).collect();
+    let t_span = &m.kinetic_energy.span;
+    let g_rat: Vec<Rat> = (raw.g.iter().flatten().map(|a| low.to_rat(a)))
+        .collect::<Result<_, _>>()
+        .map_err(|o| o.report(cx, t_span, &lower::reduced("the mass matrix")))?;
     let field = Field::from_poly(&g_rat[0].numerator);
     let g_mat = Matrix::from_linear(g_rat, n as u32, n as u32, field.clone()).map_err(|e| {
         cx.error(
@@ -350,11 +353,16 @@ pub fn exact(
             Some(m.kinetic_energy.span.clone()),
         )
     })?;
-    let a = raw
-        .a_rows
-        .iter()
-        .map(|r| r.iter().map(|x| low.to_rat(x)).collect())
-        .collect();
+    // A's rows: each holonomic constraint's, then the velocity-level ones.
+    let mut declared = m.holonomic.iter().chain(&m.constraints);
+    let a = (raw.a_rows.iter())
+        .map(|r| {
+            let span = declared.next().map_or(t_span, |d| &d.span);
+            (r.iter().map(|x| low.to_rat(x)))
+                .collect::<Result<Vec<Rat>, _>>()
+                .map_err(|o| o.report(cx, span, &lower::reduced("a constraint row")))
+        })
+        .collect::<Result<_, _>>()?;
     let g = (raw.g.iter())
         .map(|r| r.iter().map(|x| low.reduce(x)).collect())
         .collect::<Result<Vec<Vec<Atom>>, _>>()
@@ -454,8 +462,8 @@ pub fn accelerations(
         )
     };
     let column = |e: &[Atom]| {
-        let r: Vec<Rat> = e.iter().map(|a| low.to_rat(&(-a.clone()))).collect();
-        Matrix::from_linear(r, e.len() as u32, 1, exact.field.clone()).ok()
+        let r = (e.iter().map(|a| low.to_rat(&(-a.clone())))).collect::<Result<Vec<Rat>, _>>();
+        Matrix::from_linear(r.ok()?, e.len() as u32, 1, exact.field.clone()).ok()
     };
     let neg_h = column(&raw.forcing).ok_or_else(|| fail("h as a column"))?;
     let constrained = if exact.a.is_empty() {

@@ -6,7 +6,7 @@
 //!    equations and each wall's geometry as expressions ([`checks`] run on
 //!    each as it is made);
 //! 3. [`lower`]: function applications to symbols, so that entries are
-//!    rational functions; sin² + cos² = 1 reduced;
+//!    rational functions; sin² + cos² = 1 and cosh² − sinh² = 1 reduced;
 //! 4. [`walls`]: B, the hypotheses (1.3), P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B (Lemma 1,
 //!    eq. 2.4) and (I − 2P)v (eq. 2.13), exactly;
 //! 5. [`evaluate`]: each emitted function to an optimised straight-line

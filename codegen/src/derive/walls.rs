@@ -198,13 +198,17 @@ fn rows(
 ) -> Result<Option<WallB>, Reported> {
     let (sym, low, exact) = (c.sym, c.low, c.exact);
     let n = sym.vels.len();
-    let normal_r: Vec<Rat> = raw.normal.iter().map(|a| low.to_rat(a)).collect();
+    let normal_r: Vec<Rat> = (raw.normal.iter().map(|a| low.to_rat(a)))
+        .collect::<Result<_, _>>()
+        .map_err(|o| reduced(o, cx, &w.span, "the normal"))?;
     let mut candidates = vec![(normal_r, "the normal velocity".to_string())];
     for (r, label) in exact.a.iter().zip(&c.raw.a_labels) {
         candidates.push((r.clone(), label.clone()));
     }
     for (k, row) in raw.contact.iter().enumerate() {
-        let r = row.iter().map(|a| low.to_rat(a)).collect();
+        let r = (row.iter().map(|a| low.to_rat(a)))
+            .collect::<Result<_, _>>()
+            .map_err(|o| reduced(o, cx, &w.span, "a contact row"))?;
         candidates.push((r, format!("contact constraint {}", k + 1)));
     }
     let (kept, dropped) = independent_rows(&candidates, n, &exact.field);
@@ -330,7 +334,7 @@ fn admissible_collision(
                         for (s, &ds) in d.iter().enumerate() {
                             e -= m[i][ds].clone() * t[s][j].clone();
                         }
-                        low.simplify(&low.to_rat(&e))
+                        low.to_rat(&e).and_then(|r| low.simplify(&r))
                     })
                     .collect()
             })

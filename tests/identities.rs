@@ -1,0 +1,69 @@
+//! Terms that vanish only by sin² + cos² = 1 or cosh² − sinh² = 1, of
+//! plain and compound arguments: the exact algebra sees them as zero. A
+//! constraint ẋ = 0 written with such a term once divided by it (a
+//! symbolica error unwrapped: the derivation panicked), and with a compound
+//! argument the identity was not known at all. Uses the symbolic engine:
+//! run one test at a time (`RUST_TEST_THREADS=1`).
+
+use dalembert_codegen::Derivation;
+use dalembert_codegen::derive::Projection;
+
+/// A point in the plane above a floor with the constraint `constraint`.
+fn model(constraint: &str) -> String {
+    format!(
+        r#"
+[model]
+name = "identities"
+[parameters]
+m = "1"
+[coordinates]
+names = ["x", "y"]
+[dynamics]
+kinetic_energy = "m/2*(x_dot^2 + y_dot^2) + m/2*(cos(x + y)^2 + sin(x + y)^2)*y_dot^2"
+constraints = ["{constraint}"]
+[[wall]]
+name = "floor"
+surface = "y + 1"
+[initial]
+y_dot = "-1"
+"#
+    )
+}
+
+fn derive(text: &str) -> Derivation {
+    let dir = std::env::temp_dir().join(format!("dalembert-identities-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("identities.toml");
+    std::fs::write(&path, text).unwrap();
+    let d = dalembert_codegen::derive(&path);
+    std::fs::remove_dir_all(&dir).unwrap();
+    d.unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// P and the collision law, as derived.
+fn projection(d: &Derivation) -> (Vec<Vec<String>>, Vec<String>) {
+    match &d.walls[0].projection {
+        Projection::ClosedForm {
+            projector,
+            collision,
+        } => (projector.clone(), collision.clone()),
+        Projection::Structured => panic!("P is solved at run time"),
+    }
+}
+
+#[test]
+fn terms_zero_by_the_identities_are_zero() {
+    let plain = derive(&model("x_dot"));
+    let (p, law) = projection(&plain);
+    assert_eq!(law, ["-x_dot", "-y_dot"]);
+    for zero in [
+        "(cos(x)^2 + sin(x)^2 - 1)",
+        "(cos(2*x)^2 + sin(2*x)^2 - 1)",
+        "(cosh(x - y)^2 - sinh(x - y)^2 - 1)",
+        "(cosh(x)^4 - sinh(x)^4 - cosh(x)^2 - sinh(x)^2)",
+    ] {
+        let d = derive(&model(&format!("x_dot + y_dot*{zero}")));
+        assert_eq!(projection(&d), (p.clone(), law.clone()), "{zero}");
+        assert_eq!(d.mass_matrix, plain.mass_matrix, "{zero}");
+    }
+}
