@@ -67,3 +67,38 @@ fn terms_zero_by_the_identities_are_zero() {
         assert_eq!(d.mass_matrix, plain.mass_matrix, "{zero}");
     }
 }
+
+/// Two constraint rows equal by the identities (cos z times the first is
+/// the second, cos³ z + cos z sin² z = cos z): the same P and collision
+/// law as the first row alone. Taken as independent, they made ker A the
+/// z direction alone, and the wall was refused as one the constraints
+/// forbid motion across.
+#[test]
+fn rows_equal_by_the_identities_are_dependent() {
+    let text = |rows: &str| {
+        format!(
+            r#"
+[model]
+name = "identities"
+[parameters]
+m = "1"
+[coordinates]
+names = ["x", "y", "z"]
+[dynamics]
+kinetic_energy = "m/2*(x_dot^2 + y_dot^2 + z_dot^2)"
+constraints = [{rows}]
+[[wall]]
+name = "floor"
+surface = "y + 1"
+[initial]
+z_dot = "1"
+"#
+        )
+    };
+    let first = "\"cos(z)*x_dot + sin(z)*y_dot\"";
+    let one = derive(&text(first));
+    let both = derive(&text(&format!(
+        "{first}, \"(cos(z)^3 + cos(z)*sin(z)^2)*x_dot + sin(z)*y_dot\""
+    )));
+    assert_eq!(projection(&both), projection(&one));
+}

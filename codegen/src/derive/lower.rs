@@ -138,19 +138,28 @@ impl Lowering {
     }
 
     /// `a` as a rational function of the model's symbols and the lowered
-    /// function applications; zero where it vanishes by sin² + cos² = 1 or
-    /// cosh² − sinh² = 1 ([`Over`] where that test is past the budget).
+    /// function applications, its numerator and denominator reduced by
+    /// sin² + cos² = 1 and cosh² − sinh² = 1 ([`Over`] where that is past
+    /// the budget).
     ///
     /// The exact linear algebra works with rational functions of sin and
-    /// cos as independent symbols: an entry such as cos² + sin² − 1, left
-    /// as it is, would be a pivot, and what is computed from it would
-    /// divide by zero.
+    /// cos as independent symbols. Reduced, an entry that vanishes by the
+    /// identities is zero (left as cos² + sin² − 1 it would be a pivot,
+    /// and what is computed from it would divide by zero), and rows equal
+    /// by them are equal. Combinations that vanish only by the identities
+    /// after elimination are not seen (the note in `docs/model-format.md`).
     pub fn to_rat(&self, a: &Atom) -> Result<Rat, Over> {
         let r = self.rat(&self.lower(a));
-        if !self.pairs.is_empty() && is_zero(&self.reduce_trig(&r.numerator.to_expression())?) {
-            return Ok(self.rat(&Atom::num(0)));
+        if self.pairs.is_empty() {
+            return Ok(r);
         }
-        Ok(r)
+        let num = self.reduce_trig(&r.numerator.to_expression())?;
+        let den = self.reduce_trig(&r.denominator.to_expression())?;
+        if is_zero(&den) {
+            // Undefined everywhere, by the identities: left as it is.
+            return Ok(r);
+        }
+        Ok(self.rat(&(num / den)))
     }
 
     /// Reduces a polynomial modulo c² + s² − 1 for every sin/cos pair and
