@@ -43,29 +43,40 @@ pub fn expand(
     Ok(a.expand())
 }
 
-/// An expansion refused before it was made, for a caller to report at its
-/// declaration ([`Over::report`]): the bound on its terms, past
-/// [`MAX_EXPANDED_TERMS`].
+/// An expansion or reduction not made, for a caller to report at its
+/// declaration ([`Over::report`]).
 #[derive(Debug, Clone, Copy)]
-pub struct Over(pub f64);
+pub enum Over {
+    /// Refused before it was made: the bound on its terms, past
+    /// [`MAX_EXPANDED_TERMS`].
+    Terms(f64),
+    /// A quotient whose denominator vanishes by sin² + cos² = 1 or
+    /// cosh² − sinh² = 1: the exact algebra divided by it, taking rows
+    /// dependent only through the identities for independent ones.
+    VanishingDenominator,
+}
 
 impl Over {
-    /// The error at `span` naming `what`, the bound and the limit.
+    /// The error at `span` naming `what` and why (for too many terms, the
+    /// bound and the limit).
     pub fn report(self, cx: &mut Collector, span: &Range<usize>, what: &str) -> Reported {
-        let Self(bound) = self;
-        cx.error(
-            ErrorKind::Limit(format!(
+        let kind = match self {
+            Self::Terms(bound) => ErrorKind::Limit(format!(
                 "{what} may expand to {bound:.0} terms in the derivation; the limit is {MAX_EXPANDED_TERMS:.0}"
             )),
-            Some(span.clone()),
-        )
+            Self::VanishingDenominator => ErrorKind::Symbolic(format!(
+                "{what} divides by an expression that vanishes by sin² + cos² = 1 or cosh² − sinh² = 1: \
+                 rows of A or B that are dependent only through these identities are not recognised as dependent"
+            )),
+        };
+        cx.error(kind, Some(span.clone()))
     }
 }
 
 /// [`Over`] when `bound` terms exceed [`MAX_EXPANDED_TERMS`].
 pub fn check(bound: f64) -> Result<(), Over> {
     if bound > MAX_EXPANDED_TERMS {
-        return Err(Over(bound));
+        return Err(Over::Terms(bound));
     }
     Ok(())
 }

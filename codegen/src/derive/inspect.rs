@@ -46,11 +46,13 @@ pub fn same_with(a: &str, b: &str, definitions: &[(String, String)]) -> Result<b
         let value = atom_with(text, &defs)?;
         defs.insert(name.clone(), value);
     }
-    vanishes(&(atom_with(a, &defs)? - atom_with(b, &defs)?)).map_err(|budget::Over(bound)| {
-        format!(
+    vanishes(&(atom_with(a, &defs)? - atom_with(b, &defs)?)).map_err(|over| match over {
+        budget::Over::Terms(bound) => format!(
             "the difference, reduced by sin² + cos² = 1, may expand to {bound:.0} terms; the limit is {:.0}",
             budget::MAX_EXPANDED_TERMS
-        )
+        ),
+        // (A zero test divides by nothing.)
+        budget::Over::VanishingDenominator => "the difference has no value".to_string(),
     })
 }
 

@@ -184,10 +184,14 @@ impl Lowering {
 
     /// A rational function in lowest terms, sin² + cos² = 1 and
     /// cosh² − sinh² = 1 reduced,
-    /// functions raised; [`Over`] where the reduction is past the budget.
+    /// functions raised; [`Over`] where the reduction is past the budget or
+    /// the denominator vanishes by the identities.
     pub fn simplify(&self, r: &Rat) -> Result<Atom, Over> {
         let num = self.reduce_trig(&r.numerator.to_expression())?;
         let den = self.reduce_trig(&r.denominator.to_expression())?;
+        if is_zero(&den) {
+            return Err(Over::VanishingDenominator);
+        }
         let reduced = self.rat(&(num / den));
         Ok(self.raise(&reduced.to_expression()))
     }
