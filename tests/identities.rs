@@ -8,7 +8,8 @@
 use dalembert_codegen::Derivation;
 use dalembert_codegen::derive::Projection;
 
-/// A point in the plane above a floor with the constraint `constraint`.
+/// A point in space under gravity above a floor, with the constraint
+/// `constraint` (a row of A that P and q̈ both depend on).
 fn model(constraint: &str) -> String {
     format!(
         r#"
@@ -17,9 +18,10 @@ name = "identities"
 [parameters]
 m = "1"
 [coordinates]
-names = ["x", "y"]
+names = ["x", "y", "z"]
 [dynamics]
-kinetic_energy = "m/2*(x_dot^2 + y_dot^2) + m/2*(cos(x + y)^2 + sin(x + y)^2)*y_dot^2"
+kinetic_energy = "m/2*(x_dot^2 + y_dot^2 + z_dot^2) + m/2*(cos(x + y)^2 + sin(x + y)^2)*y_dot^2"
+potential = "m*y"
 constraints = ["{constraint}"]
 [[wall]]
 name = "floor"
@@ -55,7 +57,7 @@ fn projection(d: &Derivation) -> (Vec<Vec<String>>, Vec<String>) {
 fn terms_zero_by_the_identities_are_zero() {
     let plain = derive(&model("x_dot"));
     let (p, law) = projection(&plain);
-    assert_eq!(law, ["-x_dot", "-y_dot"]);
+    assert_eq!(law, ["-x_dot", "-y_dot", "z_dot"]);
     for zero in [
         "(cos(x)^2 + sin(x)^2 - 1)",
         "(cos(2*x)^2 + sin(2*x)^2 - 1)",
@@ -65,6 +67,7 @@ fn terms_zero_by_the_identities_are_zero() {
         let d = derive(&model(&format!("x_dot + y_dot*{zero}")));
         assert_eq!(projection(&d), (p.clone(), law.clone()), "{zero}");
         assert_eq!(d.mass_matrix, plain.mass_matrix, "{zero}");
+        assert_eq!(d.accelerations, plain.accelerations, "{zero}");
     }
 }
 
@@ -101,4 +104,48 @@ z_dot = "1"
         "{first}, \"(cos(z)^3 + cos(z)*sin(z)^2)*x_dot + sin(z)*y_dot\""
     )));
     assert_eq!(projection(&both), projection(&one));
+}
+
+mod property {
+    use dalembert_codegen::derive::inspect::same;
+    use proptest::prelude::*;
+
+    const ARGUMENTS: [&str; 4] = ["x", "2*x", "x + y", "x - 3*y"];
+
+    /// A sum of up to four terms k·f(u)ⁱ·g(u)ʲ·yᵐ, f and g the pair.
+    fn polynomial(pair: (&'static str, &'static str)) -> impl Strategy<Value = String> {
+        let term = (
+            -3i32..=3,
+            0u32..4,
+            0u32..4,
+            0u32..3,
+            0usize..ARGUMENTS.len(),
+        )
+            .prop_map(move |(k, i, j, m, u)| {
+                let u = ARGUMENTS[u];
+                format!("({k})*{}({u})^{i}*{}({u})^{j}*y^{m}", pair.0, pair.1)
+            });
+        proptest::collection::vec(term, 1..=4).prop_map(|t| t.join(" + "))
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(48))]
+
+        /// q + p·(sin² u + cos² u − 1) is q, and so with cosh² u − sinh² u − 1;
+        /// q + 1 is not q.
+        #[test]
+        fn multiples_of_the_identities_vanish(
+            q in polynomial(("sin", "cos")),
+            p in polynomial(("sinh", "cosh")),
+            r in polynomial(("sin", "cosh")),
+            u in 0usize..ARGUMENTS.len(),
+        ) {
+            let u = ARGUMENTS[u];
+            let trig = format!("{q} + ({r})*(sin({u})^2 + cos({u})^2 - 1)");
+            let hyperbolic = format!("{q} + ({p})*(cosh({u})^2 - sinh({u})^2 - 1)");
+            prop_assert_eq!(same(&trig, &q), Ok(true), "{}", trig);
+            prop_assert_eq!(same(&hyperbolic, &q), Ok(true), "{}", hyperbolic);
+            prop_assert_eq!(same(&format!("{q} + 1"), &q), Ok(false));
+        }
+    }
 }

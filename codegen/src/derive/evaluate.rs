@@ -20,6 +20,7 @@ use std::collections::HashMap;
 use symbolica::evaluate::{Instruction, Slot as ESlot};
 use symbolica::prelude::*;
 
+use super::atoms::children;
 use super::build::{constant_symbol, own_functions, place};
 use super::coefficients;
 use crate::ir::Constant;
@@ -164,41 +165,23 @@ fn program_in_places(outputs: &[Atom], inputs: usize) -> Result<Program, String>
 /// The applications of the functions `ours` in `a` whose argument has none
 /// of them, each with its function.
 fn innermost(a: AtomView, ours: &[Symbol], out: &mut Vec<(Atom, Func)>) {
-    match a {
-        AtomView::Fun(f) => {
-            let s = f.get_symbol();
-            if ours.contains(&s) && !f.iter().any(|x| contains_own(x, ours)) {
-                let func = Func::from_name(s.get_stripped_name()).expect("a function of ours");
-                out.push((a.to_owned(), func));
-            } else {
-                f.iter().for_each(|x| innermost(x, ours, out));
-            }
-        }
-        AtomView::Add(x) => x.iter().for_each(|x| innermost(x, ours, out)),
-        AtomView::Mul(x) => x.iter().for_each(|x| innermost(x, ours, out)),
-        AtomView::Pow(p) => {
-            let (b, e) = p.get_base_exp();
-            innermost(b, ours, out);
-            innermost(e, ours, out);
-        }
-        _ => {}
+    let parts = children(a);
+    if let AtomView::Fun(f) = a
+        && ours.contains(&f.get_symbol())
+        && !parts.iter().any(|x| contains_own(*x, ours))
+    {
+        let symbol = f.get_symbol();
+        let func = Func::from_name(symbol.get_stripped_name()).expect("a function of ours");
+        out.push((a.to_owned(), func));
+        return;
     }
+    parts.into_iter().for_each(|x| innermost(x, ours, out));
 }
 
 /// Whether `a` applies one of the functions `ours`.
 fn contains_own(a: AtomView, ours: &[Symbol]) -> bool {
-    match a {
-        AtomView::Fun(f) => {
-            ours.contains(&f.get_symbol()) || f.iter().any(|x| contains_own(x, ours))
-        }
-        AtomView::Add(x) => x.iter().any(|x| contains_own(x, ours)),
-        AtomView::Mul(x) => x.iter().any(|x| contains_own(x, ours)),
-        AtomView::Pow(p) => {
-            let (b, e) = p.get_base_exp();
-            contains_own(b, ours) || contains_own(e, ours)
-        }
-        _ => false,
-    }
+    matches!(a, AtomView::Fun(f) if ours.contains(&f.get_symbol()))
+        || children(a).into_iter().any(|x| contains_own(x, ours))
 }
 
 /// The one argument of an application.

@@ -11,6 +11,7 @@ use std::sync::Arc;
 
 use symbolica::prelude::*;
 
+use super::atoms::children;
 use super::budget::{self, Over};
 use super::build::{Differentiate, constant_symbol, own_constants, own_functions, own_symbol};
 use super::mechanics::Raw;
@@ -246,24 +247,14 @@ pub fn vanishes(a: &Atom) -> Result<bool, Over> {
 /// The arguments of the applications of `f` (one argument each) in `a`,
 /// each application before those inside it.
 fn applications(a: AtomView, f: Symbol, out: &mut Vec<Atom>) {
-    match a {
-        AtomView::Fun(g) => {
-            if g.get_symbol() == f
-                && let [arg] = g.iter().collect::<Vec<_>>()[..]
-            {
-                out.push(arg.to_owned());
-            }
-            g.iter().for_each(|x| applications(x, f, out));
-        }
-        AtomView::Add(x) => x.iter().for_each(|x| applications(x, f, out)),
-        AtomView::Mul(x) => x.iter().for_each(|x| applications(x, f, out)),
-        AtomView::Pow(p) => {
-            let (b, e) = p.get_base_exp();
-            applications(b, f, out);
-            applications(e, f, out);
-        }
-        AtomView::Var(_) | AtomView::Num(_) => {}
+    let parts = children(a);
+    if let AtomView::Fun(g) = a
+        && g.get_symbol() == f
+        && let [arg] = parts[..]
+    {
+        out.push(arg.to_owned());
     }
+    parts.into_iter().for_each(|x| applications(x, f, out));
 }
 
 /// `a` with every power cⁿ (n ≥ 2, an integer) of the pair's symbol `c`

@@ -19,6 +19,7 @@
 //! The result is plain data ([`Derivation`]); [`inspect`] has symbolic
 //! helpers for front ends and tests.
 
+mod atoms;
 mod budget;
 mod build;
 mod checks;

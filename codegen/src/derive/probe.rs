@@ -22,6 +22,8 @@ use std::collections::HashSet;
 
 use symbolica::prelude::*;
 
+use super::atoms::children;
+
 /// The two precisions, in bits.
 const LOW: u32 = 128;
 const HIGH: u32 = 256;
@@ -47,20 +49,10 @@ pub fn nonzero(a: &Atom) -> bool {
 
 /// The symbols `a` reads as variables (not the functions it applies).
 fn collect(a: AtomView, out: &mut HashSet<Symbol>) {
-    match a {
-        AtomView::Var(v) => {
-            out.insert(v.get_symbol());
-        }
-        AtomView::Fun(f) => f.iter().for_each(|x| collect(x, out)),
-        AtomView::Pow(p) => {
-            let (b, e) = p.get_base_exp();
-            collect(b, out);
-            collect(e, out);
-        }
-        AtomView::Mul(m) => m.iter().for_each(|x| collect(x, out)),
-        AtomView::Add(s) => s.iter().for_each(|x| collect(x, out)),
-        AtomView::Num(_) => {}
+    if let AtomView::Var(v) = a {
+        out.insert(v.get_symbol());
     }
+    children(a).into_iter().for_each(|x| collect(x, out));
 }
 
 /// The symbol's value at the point: in [1/4, 3/4], from an FNV-1a hash of

@@ -1,0 +1,20 @@
+//! Walking symbolica's expressions: what the passes that only look at an
+//! expression (never rebuild it) share.
+
+use symbolica::prelude::*;
+
+/// The expressions `a` is made of, one level down: a function's
+/// arguments, a sum's terms, a product's factors, a power's base and
+/// exponent; none for a number or a symbol.
+pub fn children(a: AtomView<'_>) -> Vec<AtomView<'_>> {
+    match a {
+        AtomView::Fun(f) => f.iter().collect(),
+        AtomView::Add(s) => s.iter().collect(),
+        AtomView::Mul(m) => m.iter().collect(),
+        AtomView::Pow(p) => {
+            let (b, e) = p.get_base_exp();
+            vec![b, e]
+        }
+        AtomView::Var(_) | AtomView::Num(_) => Vec::new(),
+    }
+}
