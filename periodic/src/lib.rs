@@ -31,7 +31,10 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+mod svd;
+
 use nalgebra::{DMatrix, DVector};
+use svd::Svd;
 
 use dalembert_runtime::Surfaces;
 use dalembert_runtime::linalg::{self, ProjectorError};
@@ -320,15 +323,12 @@ pub fn find<M: Surfaces<N>, const N: usize>(
         let dpi = dense(&jacobian);
         let a = (&dpi - DMatrix::identity(2 * N, 2 * N)) * &z;
         let r = DVector::from_vec(difference(&map.state, &x, angles));
-        let svd = nalgebra::linalg::SVD::try_new(a, true, true, 5.0 * f64::EPSILON, 100_000)
-            .ok_or(PeriodicError::Decomposition)?;
+        let svd = Svd::new(&a).ok_or(PeriodicError::Decomposition)?;
         let largest = svd.singular_values.max();
         if !(largest > 0.0 && largest.is_finite()) {
             return Err(PeriodicError::SingularJacobian { iterations });
         }
-        let xi = svd
-            .solve(&(-r), search.cutoff * largest)
-            .map_err(|_| PeriodicError::Decomposition)?;
+        let xi = svd.solve(&(-r), search.cutoff * largest);
         let dx = &z * xi;
         // Damping: the first of the step, its half, ... that lowers the
         // residual.
@@ -438,9 +438,8 @@ fn section_basis<M: Surfaces<N>, const N: usize>(
             columns[(N + i, j)] = dv[i];
         }
     }
-    let svd = nalgebra::linalg::SVD::try_new(columns, true, false, 5.0 * f64::EPSILON, 100_000)
-        .ok_or(PeriodicError::Decomposition)?;
-    let u = svd.u.as_ref().ok_or(PeriodicError::Decomposition)?;
+    let svd = Svd::new(&columns).ok_or(PeriodicError::Decomposition)?;
+    let u = &svd.u;
     let largest = svd.singular_values.max();
     let kept: Vec<usize> = (0..svd.singular_values.len())
         .filter(|&k| svd.singular_values[k] > 1e-8 * largest)
