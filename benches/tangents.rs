@@ -7,8 +7,8 @@
 //! - `jacobian`: the whole Jacobian by 2N (resp. Q + N) tangents
 //!   (`accelerations_jacobian`, `collide_jacobian`).
 //!
-//! And §3.2.1's bounce through 100 bounces with and without Φ followed
-//! (`simulate::Variational`, rtol 1e-10); its two-bounce return map with
+//! And §3.2.1's bounce with and without Φ followed
+//! (`simulate::Variational`, `variational` below); its two-bounce return map with
 //! and without DΠ (`simulate::return_map`, rtol 1e-12), and the search of
 //! its orbit from the paper's start with ẋ off by 1e-3 (`periodic::find`,
 //! one Newton step at its default tolerance).
@@ -60,39 +60,55 @@ fn one<M: Surfaces<N> + Default, const N: usize>(c: &mut Criterion<ThreadCpuTime
     g.finish();
 }
 
-/// §3.2.1's bounce (`ball_bounce` from its file's start) through 100
-/// bounces by Dormand–Prince, alone and with Φ followed after every step.
+/// §3.2.1's bounce (`ball_bounce` from its file's start, N = 6) alone and
+/// with Φ followed after every step: through 10⁴ bounces by Dormand–Prince
+/// (its default tolerance) and 10³ by RK4 (step 10⁻³), whose steps Φ is
+/// carried through, and through 100 bounces by Taylor's method, along
+/// whose steps Φ is integrated at rtol 1e-10.
 fn variational(c: &mut Criterion<ThreadCpuTime>) {
     use dalembert::models::BallBounce;
-    use dalembert::runtime::simulate::{Simulator, State, Variational};
+    use dalembert::runtime::simulate::Variational;
+    use dalembert::runtime::simulate::{Integrator, Rk4, Settings, Simulator, State, Taylor};
     let m = BallBounce::default();
     let start = State {
         t: 0.0,
         q: m.initial_coordinates(),
         v: m.initial_velocities(),
     };
-    let run = |follow: bool| {
-        let mut sim = Simulator::new(&m, start, Default::default()).unwrap();
-        let mut phi = Variational::new(1e-10);
-        let mut bounces = 0;
-        while bounces < 100 {
-            let step = sim.step(f64::INFINITY).unwrap();
-            bounces += step.collision.is_some() as usize;
-            if follow {
-                phi.follow(&sim, &step).unwrap();
-            }
-        }
-        (*sim.state(), *phi.matrix())
+    let with = |integrator| Settings {
+        integrator,
+        ..Settings::default()
     };
-    assert_eq!(
-        run(false).0,
-        run(true).0,
-        "following Φ leaves the run alone"
-    );
-    let mut g = c.benchmark_group("variational/ball_bounce_100_bounces");
-    g.bench_function("run", |b| b.iter(|| run(black_box(false))));
-    g.bench_function("run_and_phi", |b| b.iter(|| run(black_box(true))));
-    g.finish();
+    let methods = [
+        ("dormand_prince", Settings::default(), 10_000),
+        ("rk4", with(Integrator::Rk4(Rk4 { step: 1e-3 })), 1_000),
+        ("taylor", with(Integrator::Taylor(Taylor::default())), 100),
+    ];
+    for (name, settings, bounces) in methods {
+        let run = |follow: bool| {
+            let mut sim = Simulator::new(&m, start, settings).unwrap();
+            let mut phi = Variational::new(1e-10);
+            let mut met = 0;
+            while met < bounces {
+                let step = sim.step(f64::INFINITY).unwrap();
+                met += step.collision.is_some() as usize;
+                if follow {
+                    phi.follow(&sim, &step).unwrap();
+                }
+            }
+            (*sim.state(), *phi.matrix())
+        };
+        assert_eq!(
+            run(false).0,
+            run(true).0,
+            "following Φ leaves the run alone"
+        );
+        let mut g = c.benchmark_group(format!("variational/ball_bounce_{bounces}_bounces/{name}"));
+        g.sample_size(10);
+        g.bench_function("run", |b| b.iter(|| run(black_box(false))));
+        g.bench_function("run_and_phi", |b| b.iter(|| run(black_box(true))));
+        g.finish();
+    }
 }
 
 /// §3.2.1's return map over two bounces, alone and with DΠ, and the

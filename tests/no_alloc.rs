@@ -8,7 +8,7 @@ use dalembert::for_each_model;
 use dalembert::models::*;
 use dalembert::runtime::linalg::projector;
 use dalembert::runtime::prelude::*;
-use dalembert::runtime::simulate::{Settings, Simulator, State};
+use dalembert::runtime::simulate::{Settings, Simulator, State, Variational};
 
 struct Counting;
 
@@ -39,8 +39,9 @@ fn allocations_during(f: impl FnOnce()) -> usize {
     ALLOCATIONS.with(Cell::get) - before
 }
 
-/// A simulation of `m` from `start` to `t_end`: the collisions met and the
-/// heap allocations made, from the simulator's construction on.
+/// A simulation of `m` from `start` to `t_end`, with Φ = ∂x/∂x₀ followed
+/// ([`Variational`]): the collisions met and the heap allocations made,
+/// from the simulator's construction on.
 fn simulated<M: Surfaces<N>, const N: usize>(
     m: &M,
     start: State<N>,
@@ -50,9 +51,12 @@ fn simulated<M: Surfaces<N>, const N: usize>(
     let mut collisions = 0;
     let n = allocations_during(|| {
         let mut sim = Simulator::new(m, start, settings).unwrap();
+        let mut phi = Variational::new(1e-10);
         while sim.state().t < t_end {
             let step = sim.step(t_end).unwrap();
             collisions += u64::from(step.collision.is_some());
+            // Φ carried along, through the collisions.
+            phi.follow(&sim, &step).unwrap();
             // The motion inside the step, off its dense output, too.
             let inside = sim.state_at(0.5 * (step.t0 + step.state.t));
             std::hint::black_box(inside.unwrap());

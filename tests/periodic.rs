@@ -101,6 +101,7 @@ fn return_map_jacobian_against_differences() {
     // pendulum at a wall (a holonomic constraint).
     jacobian_matches(&BallBounce::default(), initial(&BallBounce::default()), 2);
     jacobian_matches(&Superball::default(), initial(&Superball::default()), 1);
+    jacobian_matches(&Puck::default(), initial(&Puck::default()), 1);
     jacobian_matches(&Chain3::default(), initial(&Chain3::default()), 1);
     jacobian_matches(
         &PendulumWall::default(),

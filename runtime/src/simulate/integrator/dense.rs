@@ -45,6 +45,13 @@ impl<const N: usize> Dense<N> {
         }
     }
 
+    /// The state the step started from.
+    pub fn start(&self) -> &Phase<N> {
+        match self {
+            Dense::Hermite { y0, .. } | Dense::Shampine { y0, .. } => y0,
+        }
+    }
+
     /// The interpolated coordinates alone (half the work of [`Dense::at`];
     /// a wall's f needs no more).
     pub fn position(&self, theta: f64, h: f64) -> [f64; N] {

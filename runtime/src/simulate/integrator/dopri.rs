@@ -1,7 +1,7 @@
 //! Dormand–Prince 5(4): the tableau, Shampine's dense output (1986), the
 //! error estimate and the standard step-size controller.
 
-use super::super::phase::{Phase, scaled_norm};
+use super::super::phase::{Combine, Phase, scaled_norm};
 use super::{Dense, Method, Trial};
 use crate::libm;
 
@@ -88,23 +88,39 @@ const SHRINK_MOST_ABOVE: f64 = 1845.28125;
 
 impl DormandPrince {
     /// The seven stages of one step (the last is f(y₁), FSAL) and y₁.
-    fn stages<const N: usize, E>(
-        rhs: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
-        y0: &Phase<N>,
-        f0: &Phase<N>,
+    fn stages<Y: Combine, E>(
+        rhs: &mut impl FnMut(f64, &Y) -> Result<Y, E>,
+        y0: &Y,
+        f0: &Y,
         t0: f64,
         h: f64,
-        k: &mut [Phase<N>; 7],
-    ) -> Result<Phase<N>, E> {
+        k: &mut [Y; 7],
+    ) -> Result<Y, E> {
         k[0] = *f0;
         for s in 1..7 {
-            let terms: [(f64, &Phase<N>); 6] = core::array::from_fn(|j| (A[s][j], &k[j]));
+            let terms: [(f64, &Y); 6] = core::array::from_fn(|j| (A[s][j], &k[j]));
             let ys = y0.plus(h, &terms[..s]);
             k[s] = rhs(t0 + C[s] * h, &ys)?;
         }
         // The last stage was evaluated at y₁ itself.
-        let terms: [(f64, &Phase<N>); 6] = core::array::from_fn(|j| (A[6][j], &k[j]));
+        let terms: [(f64, &Y); 6] = core::array::from_fn(|j| (A[6][j], &k[j]));
         Ok(y0.plus(h, &terms))
+    }
+
+    /// The stages of one step, y₁ and the scaled error estimate.
+    fn stepped<Y: Combine, E>(
+        &self,
+        rhs: &mut impl FnMut(f64, &Y) -> Result<Y, E>,
+        y0: &Y,
+        f0: &Y,
+        t0: f64,
+        h: f64,
+        k: &mut [Y; 7],
+    ) -> Result<(Y, f64), E> {
+        let y1 = Self::stages(rhs, y0, f0, t0, h, k)?;
+        let e_terms: [(f64, &Y); 7] = core::array::from_fn(|j| (E[j], &k[j]));
+        let err = Y::ZERO.plus(h, &e_terms);
+        Ok((y1, Y::error(&err, y0, &y1, self.rtol, self.atol)))
     }
 }
 
@@ -144,17 +160,28 @@ impl Method for DormandPrince {
         }
     }
 
-    fn advance<const N: usize, Er>(
+    fn advance<Y: Combine, Er>(
         &self,
-        rhs: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, Er>,
-        y0: &Phase<N>,
-        f0: &Phase<N>,
+        rhs: &mut impl FnMut(f64, &Y) -> Result<Y, Er>,
+        y0: &Y,
+        f0: &Y,
         t0: f64,
         h: f64,
-    ) -> Result<(Phase<N>, Option<Phase<N>>), Er> {
-        let mut k = [Phase::ZERO; 7];
+    ) -> Result<(Y, Option<Y>), Er> {
+        let mut k = [*f0; 7];
         let y1 = Self::stages(rhs, y0, f0, t0, h, &mut k)?;
         Ok((y1, Some(k[6])))
+    }
+
+    fn estimate<Y: Combine, Er>(
+        &self,
+        rhs: &mut impl FnMut(f64, &Y) -> Result<Y, Er>,
+        y0: &Y,
+        f0: &Y,
+        t0: f64,
+        h: f64,
+    ) -> Result<(Y, f64), Er> {
+        self.stepped(rhs, y0, f0, t0, h, &mut [*f0; 7])
     }
 
     fn trial<const N: usize, Er>(
@@ -166,10 +193,7 @@ impl Method for DormandPrince {
         h: f64,
     ) -> Result<Trial<N>, Er> {
         let mut k = [Phase::ZERO; 7];
-        let y1 = Self::stages(rhs, y0, f0, t0, h, &mut k)?;
-        let e_terms: [(f64, &Phase<N>); 7] = core::array::from_fn(|j| (E[j], &k[j]));
-        let err = Phase::ZERO.plus(h, &e_terms);
-        let error = scaled_norm(&err, y0, &y1, self.rtol, self.atol);
+        let (y1, error) = self.stepped(rhs, y0, f0, t0, h, &mut k)?;
         let d_terms: [(f64, &Phase<N>); 7] = core::array::from_fn(|j| (D[j], &k[j]));
         let r1 = Phase::ZERO.plus(1.0, &[(1.0, &y1), (-1.0, y0)]);
         let r2 = Phase::ZERO

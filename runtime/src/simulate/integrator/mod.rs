@@ -20,7 +20,7 @@ pub use rk4::Rk4;
 pub use taylor::Taylor;
 pub(crate) use taylor::{Plan, Reach};
 
-use super::phase::Phase;
+use super::phase::{Combine, Phase};
 
 /// The integration method between collisions.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -99,15 +99,28 @@ pub(crate) trait Method {
 
     /// The end of one step of length `h` from (t0, y0), and the derivative
     /// there when the method has it for free; no error estimate, no dense
-    /// output.
-    fn advance<const N: usize, E>(
+    /// output. Over [`Dual`](super::phase::Dual)s it is also the step's
+    /// derivative along a tangent.
+    fn advance<Y: Combine, E>(
         &self,
-        rhs: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
-        y0: &Phase<N>,
-        f0: &Phase<N>,
+        rhs: &mut impl FnMut(f64, &Y) -> Result<Y, E>,
+        y0: &Y,
+        f0: &Y,
         t0: f64,
         h: f64,
-    ) -> Result<(Phase<N>, Option<Phase<N>>), E>;
+    ) -> Result<(Y, Option<Y>), E>;
+
+    /// The end of one step of length `h` from (t0, y0) and its error
+    /// estimate, scaled as the method's error control holds it to 1 (zero
+    /// for a method without one); no dense output.
+    fn estimate<Y: Combine, E>(
+        &self,
+        rhs: &mut impl FnMut(f64, &Y) -> Result<Y, E>,
+        y0: &Y,
+        f0: &Y,
+        t0: f64,
+        h: f64,
+    ) -> Result<(Y, f64), E>;
 
     /// One step of length `h` from (t0, y0), with its error estimate and
     /// dense output, and without error control.
@@ -148,15 +161,25 @@ impl Method for RungeKutta {
     fn factor(&self, err: f64) -> f64 {
         with_method!(self, m => m.factor(err))
     }
-    fn advance<const N: usize, E>(
+    fn advance<Y: Combine, E>(
         &self,
-        rhs: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
-        y0: &Phase<N>,
-        f0: &Phase<N>,
+        rhs: &mut impl FnMut(f64, &Y) -> Result<Y, E>,
+        y0: &Y,
+        f0: &Y,
         t0: f64,
         h: f64,
-    ) -> Result<(Phase<N>, Option<Phase<N>>), E> {
+    ) -> Result<(Y, Option<Y>), E> {
         with_method!(self, m => m.advance(rhs, y0, f0, t0, h))
+    }
+    fn estimate<Y: Combine, E>(
+        &self,
+        rhs: &mut impl FnMut(f64, &Y) -> Result<Y, E>,
+        y0: &Y,
+        f0: &Y,
+        t0: f64,
+        h: f64,
+    ) -> Result<(Y, f64), E> {
+        with_method!(self, m => m.estimate(rhs, y0, f0, t0, h))
     }
     fn trial<const N: usize, E>(
         &self,

@@ -1,7 +1,7 @@
 //! Classical fourth-order Runge–Kutta with a fixed step, cubic Hermite
 //! dense output.
 
-use super::super::phase::Phase;
+use super::super::phase::{Combine, Phase};
 use super::{Dense, Method, Trial};
 
 /// Classical fourth-order Runge–Kutta with a fixed step (the last step
@@ -35,21 +35,31 @@ impl Method for Rk4 {
         1.0
     }
 
-    fn advance<const N: usize, E>(
+    fn advance<Y: Combine, E>(
         &self,
-        rhs: &mut impl FnMut(f64, &Phase<N>) -> Result<Phase<N>, E>,
-        y0: &Phase<N>,
-        f0: &Phase<N>,
+        rhs: &mut impl FnMut(f64, &Y) -> Result<Y, E>,
+        y0: &Y,
+        f0: &Y,
         t0: f64,
         h: f64,
-    ) -> Result<(Phase<N>, Option<Phase<N>>), E> {
-        let mut k = [Phase::ZERO; 4];
-        k[0] = *f0;
+    ) -> Result<(Y, Option<Y>), E> {
+        let mut k = [*f0; 4];
         k[1] = rhs(t0 + h / 2.0, &y0.plus(h, &[(0.5, &k[0])]))?;
         k[2] = rhs(t0 + h / 2.0, &y0.plus(h, &[(0.5, &k[1])]))?;
         k[3] = rhs(t0 + h, &y0.plus(h, &[(1.0, &k[2])]))?;
-        let terms: [(f64, &Phase<N>); 4] = core::array::from_fn(|j| (WEIGHTS[j], &k[j]));
+        let terms: [(f64, &Y); 4] = core::array::from_fn(|j| (WEIGHTS[j], &k[j]));
         Ok((y0.plus(h, &terms), None))
+    }
+
+    fn estimate<Y: Combine, E>(
+        &self,
+        rhs: &mut impl FnMut(f64, &Y) -> Result<Y, E>,
+        y0: &Y,
+        f0: &Y,
+        t0: f64,
+        h: f64,
+    ) -> Result<(Y, f64), E> {
+        Ok((self.advance(rhs, y0, f0, t0, h)?.0, 0.0))
     }
 
     fn trial<const N: usize, E>(
