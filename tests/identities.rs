@@ -1,5 +1,6 @@
 //! Terms that vanish only by sin² + cos² = 1 or cosh² − sinh² = 1, of
-//! plain and compound arguments: the exact algebra sees them as zero. A
+//! plain and compound arguments, or by multiple-angle formulas: the exact
+//! algebra sees them as zero. A
 //! constraint ẋ = 0 written with such a term once divided by it (a
 //! symbolica error unwrapped: the derivation panicked), and with a compound
 //! argument the identity was not known at all. Uses the symbolic engine:
@@ -89,6 +90,19 @@ fn rows_equal_by_the_identities_are_dependent() {
     assert_eq!(projection(&both), projection(&one));
 }
 
+/// A second row twice the first by the double-angle formula (sin 2z / cos z
+/// against 2 sin z): dependent, the same P and collision law as the first
+/// row alone. Before multiple angles were written in the base angle, the
+/// rows were independent and the wall was refused as one the constraints
+/// forbid motion across.
+#[test]
+fn rows_equal_by_a_double_angle_are_dependent() {
+    let first = "cos(z)*x_dot + sin(z)*y_dot";
+    let one = derive(&model(&[first]));
+    let both = derive(&model(&[first, "2*cos(z)*x_dot + sin(2*z)/cos(z)*y_dot"]));
+    assert_eq!(projection(&both), projection(&one));
+}
+
 mod property {
     use dalembert_codegen::derive::inspect::same;
     use proptest::prelude::*;
@@ -114,7 +128,8 @@ mod property {
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(48))]
 
-        /// q + p·(sin² u + cos² u − 1) is q, and so with cosh² u − sinh² u − 1;
+        /// q + p·(sin² u + cos² u − 1) is q, and so with cosh² u − sinh² u − 1,
+        /// sin 2u − 2 sin u cos u and cosh 3u − 4 cosh³ u + 3 cosh u;
         /// q + 1 is not q.
         #[test]
         fn multiples_of_the_identities_vanish(
@@ -129,6 +144,11 @@ mod property {
             prop_assert_eq!(same(&trig, &q), Ok(true), "{}", trig);
             prop_assert_eq!(same(&hyperbolic, &q), Ok(true), "{}", hyperbolic);
             prop_assert_eq!(same(&format!("{q} + 1"), &q), Ok(false));
+            // Multiple angles, in the base angle.
+            let double = format!("{q} + ({r})*(sin(2*({u})) - 2*sin({u})*cos({u}))");
+            let triple = format!("{q} + ({p})*(cosh(3*({u})) - 4*cosh({u})^3 + 3*cosh({u}))");
+            prop_assert_eq!(same(&double, &q), Ok(true), "{}", double);
+            prop_assert_eq!(same(&triple, &q), Ok(true), "{}", triple);
         }
     }
 }

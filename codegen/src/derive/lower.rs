@@ -1,7 +1,9 @@
 //! Pass 3: function applications lowered to symbols, so that every entry of
 //! G, A and B is a rational function of symbols and exact linear algebra
 //! applies; sin² + cos² = 1 and cosh² − sinh² = 1 reduced; the functions
-//! raised back before evaluation.
+//! raised back before evaluation. Before lowering, sin, cos, sinh and cosh
+//! of a whole multiple n·u (or of −u) are written in those of u
+//! ([`in_base_arguments`]), so that the identities reach multiple angles.
 //!
 //! A [`Lowering`] is made only from the whole [`Raw`] derivation, so no
 //! expression that is later turned into a rational function can miss it.
@@ -48,7 +50,7 @@ impl Lowering {
     /// symbol; sin and cos, and sinh and cosh, of the same argument are
     /// paired for the reduction.
     pub fn new(sym: &Symbols, raw: &Raw) -> Self {
-        let atoms: Vec<Atom> = raw.expressions().into_iter().map(own_constants).collect();
+        let atoms: Vec<Atom> = raw.expressions().into_iter().map(prepared).collect();
         let mut base: Vec<Symbol> = sym
             .params
             .iter()
@@ -118,7 +120,7 @@ impl Lowering {
     }
 
     fn lower(&self, a: &Atom) -> Atom {
-        let mut a = own_constants(a);
+        let mut a = prepared(a);
         for l in &self.lowered {
             a = a.replace(l.function.clone()).with(Atom::from(l.symbol));
         }
@@ -237,11 +239,95 @@ pub fn reduced(what: &str) -> String {
 /// applications, sin² + cos² = 1 and cosh² − sinh² = 1 reduced; [`Over`]
 /// where the reduction is past the budget.
 pub fn vanishes(a: &Atom) -> Result<bool, Over> {
-    let a = own_constants(a);
+    let a = prepared(a);
     let low = Lowering::of(std::slice::from_ref(&a), Vec::new());
     let r: Rat = low.lower(&a).to_rational_polynomial(&Q, &Z, None);
     let numerator = low.reduce_trig(&r.numerator.to_expression())?;
     Ok(is_zero(&numerator))
+}
+
+/// What is lowered: `a` with our names for e and π, in base arguments.
+fn prepared(a: &Atom) -> Atom {
+    in_base_arguments(own_constants(a).as_view())
+}
+
+/// The largest multiple n in sin(n·u) (and cos, sinh, cosh) written in the
+/// functions of u; a larger one is left as it is.
+const MAX_MULTIPLE: i64 = 12;
+
+/// `a` with sin, cos, sinh and cosh of n·u (n a whole number, 2 ≤ |n| ≤
+/// [`MAX_MULTIPLE`]) or of −u written as polynomials in those of u, from
+/// (c + i s)ⁿ for sin and cos and (c + s)ⁿ for sinh and cosh: cos(2u) =
+/// c² − s², sin(−u) = −s. Equal to `a` as a function; the identities of
+/// the pairs then see sin(2x) − 2 sin x cos x as zero. tanh is left alone:
+/// written sinh/cosh it would overflow where tanh itself does not.
+fn in_base_arguments(a: AtomView) -> Atom {
+    match a {
+        AtomView::Fun(f) => {
+            let args: Vec<Atom> = f.iter().map(in_base_arguments).collect();
+            if let [u] = &args[..]
+                && let Some(x) = multiple_of(f.get_symbol(), u)
+            {
+                return x;
+            }
+            FunctionBuilder::new(f.get_symbol())
+                .add_args(&args)
+                .finish()
+        }
+        AtomView::Pow(p) => {
+            let (b, e) = p.get_base_exp();
+            in_base_arguments(b).pow(in_base_arguments(e))
+        }
+        AtomView::Mul(m) => m.iter().fold(Atom::num(1), |p, x| p * in_base_arguments(x)),
+        AtomView::Add(t) => sum(t.iter().map(in_base_arguments).collect()),
+        AtomView::Var(_) | AtomView::Num(_) => a.to_owned(),
+    }
+}
+
+/// f(u) in the functions of the base argument when f is sin, cos, sinh or
+/// cosh and u = n·v with a whole n ≠ 0, 1 ([`in_base_arguments`]).
+fn multiple_of(f: Symbol, u: &Atom) -> Option<Atom> {
+    let [sinh, cosh] = [Function::Sinh, Function::Cosh].map(|g| own_symbol(g.name()));
+    let (s, c, circular) = if f == Symbol::SIN || f == Symbol::COS {
+        (Symbol::SIN, Symbol::COS, true)
+    } else if f == sinh || f == cosh {
+        (sinh, cosh, false)
+    } else {
+        return None;
+    };
+    let AtomView::Mul(m) = u.as_view() else {
+        return None;
+    };
+    let mut n = None;
+    let mut base = Atom::num(1);
+    for x in m.iter() {
+        match x {
+            AtomView::Num(_) if n.is_none() => n = Some(x.to_string().parse::<i64>().ok()?),
+            _ => base *= x.to_owned(),
+        }
+    }
+    let n = n?;
+    if n == 0 || n == 1 || n.abs() > MAX_MULTIPLE {
+        return None;
+    }
+    let (sv, cv) = (function!(s, base.clone()), function!(c, base));
+    let odd = f == s;
+    let m = n.unsigned_abs();
+    // Σ over k of the parity of f: binom(m, k) c^(m−k) s^k, with the sign
+    // of i^k for sin and cos.
+    let mut terms = Vec::new();
+    let mut binomial: i64 = 1;
+    for k in 0..=m {
+        if (k % 2 == 1) == odd {
+            let sign = if circular && (k / 2) % 2 == 1 { -1 } else { 1 };
+            let power = |x: &Atom, e: u64| x.pow(Atom::num(i64::try_from(e).unwrap_or(0)));
+            terms.push(Atom::num(sign * binomial) * power(&cv, m - k) * power(&sv, k));
+        }
+        binomial = binomial * i64::try_from(m - k).unwrap_or(0) / i64::try_from(k + 1).unwrap_or(1);
+    }
+    let value = sum(terms);
+    // sin and sinh are odd, cos and cosh even.
+    Some(if odd && n < 0 { -value } else { value })
 }
 
 /// The arguments of the applications of `f` (one argument each) in `a`,
@@ -316,11 +402,40 @@ mod tests {
         }
         for (a, b) in [
             ("cosh(x)^2 + sinh(x)^2", "1"),
+            // Not multiples of one argument.
+            ("sin(x/2)", "2*sin(x/4)*cos(x/4)"),
+            ("sin(2*x)", "2*sin(x)*cos(y)"),
+            ("cos(13*x)^2 + sin(x)^2", "1"),
             ("cosh(x)^2 - sinh(y)^2", "1"),
             ("cosh(x)^2 - sin(x)^2", "1"),
             ("cos(x)^2 - sinh(x)^2", "1"),
         ] {
             assert_eq!(same(a, b), Ok(false), "{a} ≠ {b}");
+        }
+    }
+
+    /// Whole multiples of an argument, and its negative, in the functions of
+    /// the argument: sympy's double angles, the triple-angle formulas, mixed
+    /// multiples of one angle and the hyperbolic ones.
+    #[test]
+    fn multiples_of_an_argument_reduce() {
+        for (a, b) in [
+            ("sin(2*x)", "2*sin(x)*cos(x)"),
+            ("cos(2*x)", "1 - 2*sin(x)^2"),
+            ("(1 + cos(2*a))/2", "cos(a)^2"),
+            ("cos(3*x)", "4*cos(x)^3 - 3*cos(x)"),
+            ("sin(3*x)", "3*sin(x) - 4*sin(x)^3"),
+            ("sin(-x) + sin(x)", "0"),
+            ("cos(-2*x)", "cos(2*x)"),
+            ("sin(4*x*y)", "2*sin(2*x*y)*cos(2*x*y)"),
+            ("sin(6*x)", "2*sin(3*x)*cos(3*x)"),
+            ("cos(12*x)", "2*cos(6*x)^2 - 1"),
+            ("sinh(2*x)", "2*sinh(x)*cosh(x)"),
+            ("cosh(2*x)", "1 + 2*sinh(x)^2"),
+            ("sinh(-3*x)", "-3*sinh(x) - 4*sinh(x)^3"),
+            ("y*sin(2*(x + z))", "2*y*sin(x + z)*cos(x + z)"),
+        ] {
+            assert_eq!(same(a, b), Ok(true), "{a} = {b}");
         }
     }
 }
