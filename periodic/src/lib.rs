@@ -49,7 +49,9 @@ use dalembert_runtime::simulate::{
 pub struct Search {
     /// The simulator's settings for every evaluation of Π.
     pub settings: Settings,
-    /// Relative tolerance of Φ's integration (DΠ).
+    /// Relative tolerance of Φ (DΠ): of its own error estimate on
+    /// Dormand–Prince steps, of its integration along steps of Taylor's
+    /// method ([`Variational`](dalembert_runtime::simulate::Variational)).
     pub rtol: f64,
     /// Newton's method stops when |Π(x₀) − x₀|∞ ≤ `tolerance` · max(1, |x₀|∞).
     pub tolerance: f64,
