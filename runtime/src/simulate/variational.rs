@@ -52,8 +52,11 @@ pub struct Variational<const N: usize> {
     phi: StateMatrix<N>,
     /// Φ at the end of the last step's flight: before its collision.
     before: StateMatrix<N>,
+    /// Φ's own error control: Dormand–Prince at the tolerance of
+    /// [`Variational::new`].
     method: DormandPrince,
-    /// The last accepted length of a step of Φ's integration.
+    /// The last accepted length of a step of Φ's integration along a step
+    /// of Taylor's method, where the next such integration starts.
     h: f64,
 }
 
