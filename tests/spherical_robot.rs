@@ -96,6 +96,12 @@ fn momentum_about_contact(q: &[f64; 6], v: &[f64; 6]) -> V3 {
     )
 }
 
+/// The velocity of the shell's point touching the floor: Ṡ − ω_s × r e_z.
+fn slip(q: &[f64; 6], v: &[f64; 6]) -> V3 {
+    let (_, omega) = attitude(q, v);
+    add([v[0], v[1], 0.0], scale(-1.0, cross(omega, [0.0, 0.0, R])))
+}
+
 fn largest_difference(a: V3, b: V3) -> f64 {
     (0..3).map(|i| (a[i] - b[i]).abs()).fold(0.0, f64::max)
 }
@@ -108,14 +114,10 @@ fn a_spherical_robot_keeps_its_integrals_through_rough_impacts() {
     let (q0, v0) = (start.q, start.v);
     // The file gives the angle rates; the centre's velocity followed from
     // the rolling rows, so the floor's contact point is at rest.
-    let (_, omega) = attitude(&q0, &v0);
-    let slip = add(
-        [v0[0], v0[1], 0.0],
-        scale(-1.0, cross(omega, [0.0, 0.0, R])),
-    );
+    let at_start = slip(&q0, &v0);
     assert!(
-        slip.iter().all(|x| x.abs() < 1e-12),
-        "slip at the start {slip:?}"
+        at_start.iter().all(|x| x.abs() < 1e-12),
+        "slip at the start {at_start:?}"
     );
     assert!(v0[0] < 0.0, "rolling towards the wall: {v0:?}");
 
@@ -143,14 +145,10 @@ fn a_spherical_robot_keeps_its_integrals_through_rough_impacts() {
             "t = {}: rotor spin {spin0} → {spin}",
             s.t
         );
-        let (_, omega) = attitude(&s.q, &s.v);
-        let slip = add(
-            [s.v[0], s.v[1], 0.0],
-            scale(-1.0, cross(omega, [0.0, 0.0, R])),
-        );
+        let moving = slip(&s.q, &s.v);
         assert!(
-            slip.iter().all(|x| x.abs() < 1e-9),
-            "t = {}: slip {slip:?}",
+            moving.iter().all(|x| x.abs() < 1e-9),
+            "t = {}: slip {moving:?}",
             s.t
         );
         assert!(
