@@ -196,7 +196,18 @@ impl Lowering {
             return Err(Over::VanishingDenominator);
         }
         let reduced = self.rat(&(num / den));
-        Ok(self.raise(&reduced.to_expression()))
+        let raised = self.raise(&reduced.to_expression());
+        // As a rational function an exponential of a sum is split, the
+        // terms of opposite signs apart (exp(−(1 + x² + y²)/w²) times a
+        // sum of terms in exp((2x cos a + 2y sin a)/w²) for a narrow
+        // Gaussian post), and the factors overflow to 0 · ∞ = NaN where
+        // the whole is a number. Expanded, each term's exponentials are
+        // one again (the symbolic engine multiplies them into one).
+        Ok(if holds_exp(raised.as_view()) {
+            raised.expand()
+        } else {
+            raised
+        })
     }
 
     /// [`Lowering::simplify`] of an expression.
@@ -244,6 +255,24 @@ pub fn vanishes(a: &Atom) -> Result<bool, Over> {
     let r: Rat = low.lower(&a).to_rational_polynomial(&Q, &Z, None);
     let numerator = low.reduce_trig(&r.numerator.to_expression())?;
     Ok(is_zero(&numerator))
+}
+
+/// Whether `a` holds an exponential: exp(u), or e^u as the symbolic
+/// engine writes it.
+fn holds_exp(a: AtomView) -> bool {
+    is_exp(a) || children(a).into_iter().any(holds_exp)
+}
+
+/// Whether `a` is exp(u) or e^u.
+fn is_exp(a: AtomView) -> bool {
+    match a {
+        AtomView::Fun(f) => f.get_symbol() == Symbol::EXP,
+        AtomView::Pow(p) => {
+            let e = [Symbol::E, constant_symbol(Constant::E)];
+            matches!(p.get_base_exp().0, AtomView::Var(v) if e.contains(&v.get_symbol()))
+        }
+        _ => false,
+    }
 }
 
 /// What is lowered: `a` with our names for e and π, in base arguments.
@@ -383,6 +412,36 @@ fn sum(mut terms: Vec<Atom>) -> Atom {
 #[cfg(test)]
 mod tests {
     use super::super::inspect::same;
+    use super::*;
+    use crate::derive::build::Namespace;
+
+    /// A narrow post's f = 1/2 − exp(−((x − cos a)² + (y − sin a)²)/w²),
+    /// differentiated and reduced (sin² a + cos² a = 1): as a rational
+    /// function its exponential is split into exp(−(1 + x² + y²)/w²) and
+    /// exp((2x cos a + 2y sin a)/w²), which overflow apart to 0 · ∞ where
+    /// the whole is a number. Reduced, each term holds one exponential.
+    #[test]
+    fn reduced_exponentials_stay_whole() {
+        crate::lock::acquire().unwrap();
+        let _ns = Namespace::enter("lower test");
+        let names = ["x", "y", "a", "w"].map(own_symbol);
+        let [x, y, a, w] = names.map(Atom::from);
+        let two = Atom::num(2);
+        let distance = (&x - function!(Symbol::COS, a.clone())).pow(two.clone())
+            + (&y - function!(Symbol::SIN, a.clone())).pow(two.clone());
+        let f = Atom::num(1) / &two - function!(Symbol::EXP, -(distance / w.pow(two)));
+        let d = f.d(names[0]);
+        let low = Lowering::of(std::slice::from_ref(&prepared(&d)), names.to_vec());
+        let reduced = low.simplify(&low.to_rat(&d).unwrap()).unwrap();
+        fn exps(a: AtomView) -> usize {
+            usize::from(is_exp(a)) + children(a).into_iter().map(exps).sum::<usize>()
+        }
+        let terms: Vec<usize> = match reduced.as_view() {
+            AtomView::Add(t) => t.iter().map(exps).collect(),
+            v => vec![exps(v)],
+        };
+        assert!(terms.iter().all(|&k| k == 1), "{reduced}");
+    }
 
     /// Zero only by sin² + cos² = 1 or cosh² − sinh² = 1, powers
     /// included; and near misses that are not zero.
