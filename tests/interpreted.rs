@@ -11,6 +11,7 @@ use std::path::Path;
 use dalembert::for_each_model;
 use dalembert::models::*;
 use dalembert::runtime::Rows;
+use dalembert::runtime::interval::Interval;
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{Integrator, Settings, Simulator, Taylor};
 use dalembert::runtime::taylor::{CAPACITY, Series};
@@ -184,6 +185,37 @@ fn same_functions<M: Surfaces<N>, I: Surfaces<N>, const N: usize>(
             &[sc.unwrap_or(f64::NAN)],
             &[si.unwrap_or(f64::NAN)],
         );
+        // Bounds over a box about q: the same interval operations (a
+        // parameter-only value is a point in the one, its interval in the
+        // other: they differ by rounding), holding f and df at q.
+        let near: [Interval; N] = std::array::from_fn(|k| Interval::new(q[k] - 1e-3, q[k] + 1e-3));
+        let ends = |x: Interval| [x.lo, x.hi];
+        let agree = |what: &str, a: [f64; 2], b: [f64; 2]| {
+            let scale = 1.0_f64.max(a[0].abs()).max(a[1].abs());
+            for (x, y) in a.iter().zip(b) {
+                assert!(
+                    (x - y).abs() <= 1e-12 * scale || x == &y,
+                    "{what}: compiled {a:?}, interpreted {b:?}"
+                );
+            }
+        };
+        let (bc, bi) = (c.surface_bounds(wc, &near), i.surface_bounds(wi, &near));
+        let (bc, bi) = (
+            bc.expect("compiled f bounds"),
+            bi.expect("interpreted f bounds"),
+        );
+        agree(&format!("{w} f bounds"), ends(bc), ends(bi));
+        assert!(bc.contains(c.surface(wc, q)), "{w}: f outside {bc:?}");
+        let (gc, gi) = (c.normal_bounds(wc, &near), i.normal_bounds(wi, &near));
+        let (gc, gi) = (
+            gc.expect("compiled df bounds"),
+            gi.expect("interpreted df bounds"),
+        );
+        let normal = c.normal(wc, q);
+        for k in 0..N {
+            agree(&format!("{w} df bounds {k}"), ends(gc[k]), ends(gi[k]));
+            assert!(gc[k].contains(normal[k]), "{w}: df {k} outside {:?}", gc[k]);
+        }
     }
 }
 

@@ -19,6 +19,7 @@
 #![warn(missing_docs)]
 
 pub mod dynamics;
+pub mod interval;
 pub mod linalg;
 pub mod saltation;
 pub mod simulate;

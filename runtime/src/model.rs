@@ -4,6 +4,7 @@
 //! An instantaneous model (`Q = 0`, the paper's §3) implements only the
 //! first two: it has no motion and no surfaces.
 
+use crate::interval::Interval;
 use crate::taylor::{Coefficients, Series, SeriesWork};
 use crate::{Rows, Values, linalg};
 
@@ -283,6 +284,26 @@ pub trait Surfaces<const N: usize>: Dynamics<N> + Walls<N, N> {
     /// the default `None` (unknown) means steps are not aimed at this wall.
     fn surface_hessian(&self, wall: Self::Wall, q: &[f64; N], v: &[f64; N]) -> Option<f64> {
         let _ = (wall, q, v);
+        None
+    }
+
+    /// Bounds on the wall's f over a box of coordinates (`q[i]` the range
+    /// of coordinate i): every value f takes on the box lies in them
+    /// ([`Interval::ENTIRE`] where f is undefined somewhere on it). The
+    /// simulator proves stretches of a step free of the wall with them, so
+    /// that no dip of f below zero between its samples goes unseen.
+    /// Generated models emit it; the default `None` (unknown) leaves the
+    /// wall to the samples alone.
+    fn surface_bounds(&self, wall: Self::Wall, q: &[Interval; N]) -> Option<Interval> {
+        let _ = (wall, q);
+        None
+    }
+
+    /// Bounds on the wall's normal df(q) over a box of coordinates, as
+    /// [`Surfaces::surface_bounds`] on f: with them the simulator proves f
+    /// monotone along a stretch of a step. The default `None`: unknown.
+    fn normal_bounds(&self, wall: Self::Wall, q: &[Interval; N]) -> Option<[Interval; N]> {
+        let _ = (wall, q);
         None
     }
 

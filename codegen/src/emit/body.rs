@@ -2,6 +2,11 @@
 //! temporaries `t{k}`, outputs `o{k}`; sin and cos of one value computed by
 //! one `sincos` call; parameter-only values stored once (`pre[k]`) and read
 //! per call (`self.pre[k]`).
+//!
+//! The same statements format a program over the runtime's `Interval`
+//! (`Ctx::bounds`): each instruction is then the interval operation of
+//! its machine form (xⁿ as `powi`, a tight power, where floats multiply),
+//! and numbers, parameters and kept values enter as points.
 
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
@@ -11,8 +16,11 @@ use crate::plan::Step;
 use crate::program::machine::{Machine, Operand};
 use crate::program::{Program, Slot};
 
-/// `f64` or `f32`.
+/// `f64` or `f32` (or the runtime's `Interval`, formatting bounds).
 pub(super) fn real(d: &Ctx) -> TokenStream {
+    if d.bounds {
+        return quote! { ::dalembert_runtime::interval::Interval };
+    }
     match d.scalar {
         Scalar::F64 => quote! { f64 },
         Scalar::F32 => quote! { f32 },
@@ -36,6 +44,27 @@ pub(super) fn libm_fn(d: &Ctx, name: &str) -> TokenStream {
     quote! { ::dalembert_runtime::libm::#f }
 }
 
+/// The type annotation of a `let`: `: f64` (`: f32`), or none over
+/// intervals (inferred: the bodies stay readable).
+fn annotation(d: &Ctx) -> TokenStream {
+    if d.bounds {
+        TokenStream::new()
+    } else {
+        let real = real(d);
+        quote! { : #real }
+    }
+}
+
+/// A number (a literal, a parameter, a kept value) as a value of the
+/// formatted type: itself, or the interval of that one point.
+fn number(d: &Ctx, x: TokenStream) -> TokenStream {
+    if d.bounds {
+        quote! { Interval::point(#x) }
+    } else {
+        x
+    }
+}
+
 /// Where statements go: the per-call function, or the block run once per
 /// parameter set.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -56,7 +85,7 @@ pub(super) fn statements(d: &Ctx, p: &Program, steps: &[Step], place: Place) -> 
             }
         }
     }
-    let real = real(d);
+    let real = annotation(d);
     let params = match place {
         Place::Call => quote! { self.params },
         Place::Once => quote! { params },
@@ -64,7 +93,12 @@ pub(super) fn statements(d: &Ctx, p: &Program, steps: &[Step], place: Place) -> 
     let inputs = used.iter().enumerate().filter(|(_, u)| **u).map(|(i, _)| {
         let name = format_ident!("i{i}");
         let value = input_value(d, i, &params);
-        quote! { let #name: #real = #value; }
+        let value = if i < d.model.params.len() {
+            number(d, value)
+        } else {
+            value
+        };
+        quote! { let #name #real = #value; }
     });
     let stmts = p.instrs.iter().zip(steps).map(|(ins, step)| {
         let dst = ins.dst();
@@ -78,7 +112,8 @@ pub(super) fn statements(d: &Ctx, p: &Program, steps: &[Step], place: Place) -> 
             }
             Step::Load(k) => {
                 let (dst, k) = (slot(d, p, dst), Literal::usize_unsuffixed(*k));
-                quote! { let #dst: #real = self.pre[#k]; }
+                let value = number(d, quote! { self.pre[#k] });
+                quote! { let #dst #real = #value; }
             }
             Step::Keep(m, k) => {
                 let value = expression(d, p, m);
@@ -94,7 +129,13 @@ pub(super) fn statements(d: &Ctx, p: &Program, steps: &[Step], place: Place) -> 
 /// sin/cos pair computes both into `sc{k}_sin` and `sc{k}_cos`, and each
 /// half takes its own.
 fn statement(d: &Ctx, p: &Program, dst: Slot, m: &Machine) -> TokenStream {
-    let real = real(d);
+    let both = if d.bounds {
+        TokenStream::new()
+    } else {
+        let real = real(d);
+        quote! { : (#real, #real) }
+    };
+    let real = annotation(d);
     let dst = slot(d, p, dst);
     let half = |pair: usize, sin: bool| {
         let (s, c) = (format_ident!("sc{pair}_sin"), format_ident!("sc{pair}_cos"));
@@ -103,19 +144,25 @@ fn statement(d: &Ctx, p: &Program, dst: Slot, m: &Machine) -> TokenStream {
     match *m {
         Machine::SinCos { x, pair, sin } => {
             let (mine, s, c) = half(pair, sin);
-            let (call, x) = (libm_fn(d, "sincos"), slot(d, p, x));
+            let x = slot(d, p, x);
+            let call = if d.bounds {
+                quote! { #x.sincos() }
+            } else {
+                let f = libm_fn(d, "sincos");
+                quote! { #f(#x) }
+            };
             quote! {
-                let (#s, #c): (#real, #real) = #call(#x);
-                let #dst: #real = #mine;
+                let (#s, #c) #both = #call;
+                let #dst #real = #mine;
             }
         }
         Machine::Half { pair, sin } => {
             let mine = half(pair, sin).0;
-            quote! { let #dst: #real = #mine; }
+            quote! { let #dst #real = #mine; }
         }
         _ => {
             let value = expression(d, p, m);
-            quote! { let #dst: #real = #value; }
+            quote! { let #dst #real = #value; }
         }
     }
 }
@@ -126,14 +173,23 @@ fn expression(d: &Ctx, p: &Program, m: &Machine) -> TokenStream {
         Operand::Slot(s) => slot(d, p, s),
         Operand::Kept(k) => {
             let k = Literal::usize_unsuffixed(k);
-            quote! { self.pre[#k] }
+            number(d, quote! { self.pre[#k] })
         }
     };
-    let over = |reciprocal: bool, x: TokenStream| {
-        if reciprocal {
-            quote! { 1.0 / #x }
+    let over = |reciprocal: bool, x: TokenStream| match (reciprocal, d.bounds) {
+        (false, _) => x,
+        (true, false) => quote! { 1.0 / #x },
+        (true, true) => quote! { (#x).recip() },
+    };
+    // A function of x: libm's, or the interval's method of that name.
+    let call = |name: &str, x: TokenStream, arg: Option<Literal>| {
+        if d.bounds {
+            let f = format_ident!("{name}");
+            quote! { #x.#f(#arg) }
         } else {
-            x
+            let f = libm_fn(d, name);
+            let arg = arg.map(|a| quote! { , #a });
+            quote! { #f(#x #arg) }
         }
     };
     match m {
@@ -152,29 +208,33 @@ fn expression(d: &Ctx, p: &Program, m: &Machine) -> TokenStream {
         }
         Machine::Number(x) => {
             let a = Literal::f64_unsuffixed(x.abs());
-            if x.is_sign_negative() {
+            let value = if x.is_sign_negative() {
                 quote! { -#a }
             } else {
                 quote! { #a }
-            }
+            };
+            number(d, value)
         }
         Machine::Power { x, n, reciprocal } => {
             let x = slot(d, p, *x);
-            let product = join(std::iter::repeat_n(x, *n as usize), quote! { * });
-            over(*reciprocal, quote! { (#product) })
+            let power = if d.bounds {
+                let n = Literal::u32_unsuffixed(*n);
+                quote! { #x.powi(#n) }
+            } else {
+                let product = join(std::iter::repeat_n(x, *n as usize), quote! { * });
+                quote! { (#product) }
+            };
+            over(*reciprocal, power)
         }
         Machine::Pow { x, e, reciprocal } => {
-            let (f, x, e) = (libm_fn(d, "pow"), slot(d, p, *x), lit(d, *e));
-            over(*reciprocal, quote! { #f(#x, #e) })
+            let (x, e) = (slot(d, p, *x), lit(d, *e));
+            over(*reciprocal, call("pow", x, Some(e)))
         }
         Machine::Sqrt { x, reciprocal } => {
-            let (f, x) = (libm_fn(d, "sqrt"), slot(d, p, *x));
-            over(*reciprocal, quote! { #f(#x) })
+            let x = slot(d, p, *x);
+            over(*reciprocal, call("sqrt", x, None))
         }
-        Machine::Call(f, x) => {
-            let (f, x) = (libm_fn(d, f.name()), slot(d, p, *x));
-            quote! { #f(#x) }
-        }
+        Machine::Call(f, x) => call(f.name(), slot(d, p, *x), None),
         Machine::Copy(x) => slot(d, p, *x),
         Machine::SinCos { .. } | Machine::Half { .. } => {
             unreachable!("a sin/cos pair is a statement of its own")
@@ -213,7 +273,7 @@ pub(super) fn slot(d: &Ctx, p: &Program, s: Slot) -> TokenStream {
         Slot::Out(i) => format_ident!("o{i}"),
         Slot::Const(i) => {
             let lit = lit(d, p.consts[i]);
-            return quote! { #lit };
+            return number(d, quote! { #lit });
         }
     };
     quote! { #name }

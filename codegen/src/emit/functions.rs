@@ -9,8 +9,9 @@ use super::body::{self, Place, lit, real};
 use super::{Ctx, Scalar, doc_attr, ident};
 use crate::derive::{Function, WallDerivation};
 use crate::ir::camel;
+use crate::plan::Step;
 use crate::program::Program;
-use crate::quantity::{Inputs, Shape};
+use crate::quantity::{Inputs, Quantity, Shape};
 
 /// `impl Model { consts, new, every function }`.
 pub(super) fn inherent_impl(d: &Ctx) -> TokenStream {
@@ -113,7 +114,44 @@ fn wall_fns(d: &Ctx, w: &WallDerivation) -> TokenStream {
         .iter()
         .map(|f| emit_function(d, f, Some(&w.name)));
     let structured = w.structured().then(|| structured_fns(d, w));
-    quote! { #( #fns )* #structured }
+    let bounds = bounds_fns(d, w);
+    quote! { #( #fns )* #structured #bounds }
+}
+
+/// The wall's f and normal df over a box of coordinates: the programs of
+/// `{wall}_surface` and `{wall}_normal` formatted over the runtime's
+/// intervals, with the same parameter-only values (f64 models with
+/// coordinates; the simulator proves stretches of a step free of the wall
+/// with them).
+fn bounds_fns(d: &Ctx, w: &WallDerivation) -> TokenStream {
+    if d.scalar != Scalar::F64 || d.model.coordinates.is_empty() {
+        return TokenStream::new();
+    }
+    let b = &Ctx { bounds: true, ..*d };
+    let interval = real(b);
+    let nl = Literal::usize_unsuffixed(dims(d).1);
+    let fns = [Quantity::Surface, Quantity::Normal].map(|quantity| {
+        let Some(f) = w.functions.iter().find(|f| f.quantity == quantity) else {
+            return TokenStream::new();
+        };
+        let spec = quantity.spec();
+        let name = format!("{}_{}_bounds", w.name, spec.name);
+        let doc = format!(
+            "Wall `{}`: bounds on `{}_{}` over a box of coordinates (each value it takes there lies in them).",
+            w.name, w.name, spec.name
+        );
+        let (ret, result) = match spec.shape {
+            Shape::Vector => {
+                let zero = quote! { Interval::point(0.0) };
+                let outs = padded_outputs(&f.program, dims(d).1, zero);
+                (quote! { [#interval; #nl] }, quote! { [#(#outs),*] })
+            }
+            _ => (interval.clone(), quote! { o0 }),
+        };
+        let steps = &d.plan.function(&format!("{}_{}", w.name, spec.name)).call;
+        function(b, &name, &doc, &f.program, steps, spec.inputs, ret, result)
+    });
+    quote! { #( #fns )* }
 }
 
 /// One function, as its row of the quantity table says (a wall's is named
@@ -131,7 +169,7 @@ fn emit_function(d: &Ctx, f: &Function, wall: Option<&str>) -> TokenStream {
     let (ret, result) = match spec.shape {
         Shape::Scalar => (real, quote! { o0 }),
         Shape::Vector => {
-            let outs = padded_outputs(p, n);
+            let outs = padded_outputs(p, n, quote! { 0.0 });
             (quote! { [#real; #nl] }, quote! { [#(#outs),*] })
         }
         Shape::Matrix => {
@@ -154,7 +192,7 @@ fn emit_function(d: &Ctx, f: &Function, wall: Option<&str>) -> TokenStream {
             counted(d, "Rows", quote! { [[f32; #nl]; #nl] }, array, f.rows)
         }
         Shape::Values => {
-            let outs = padded_outputs(p, n);
+            let outs = padded_outputs(p, n, quote! { 0.0 });
             let array = quote! { [#(#outs),*] };
             counted(d, "Values", quote! { [f32; #nl] }, array, f.rows)
         }
@@ -186,7 +224,8 @@ fn emit_function(d: &Ctx, f: &Function, wall: Option<&str>) -> TokenStream {
             )
         }
     };
-    function(d, &name, &doc, p, inputs, ret, result)
+    let steps = &d.plan.function(&name).call;
+    function(d, &name, &doc, p, steps, inputs, ret, result)
 }
 
 /// P of a wall evaluated at run time from the generated G and B by the
@@ -254,37 +293,56 @@ fn args(d: &Ctx, inputs: Inputs) -> TokenStream {
 }
 
 /// An emitted method: doc, `#[inline]`, the arguments, the program's
-/// per-call statements, then `result` of type `ret`.
+/// per-call statements (`steps`, the plan's for it), then `result` of type
+/// `ret`.
+#[allow(clippy::too_many_arguments)]
 fn function(
     d: &Ctx,
     name: &str,
     doc: &str,
     p: &Program,
+    steps: &[Step],
     inputs: Inputs,
     ret: TokenStream,
     result: TokenStream,
 ) -> TokenStream {
     let f = ident(name);
     let args = args(d, inputs);
-    let steps = &d.plan.function(name).call;
     let body = body::statements(d, p, steps, Place::Call);
     let doc = doc_attr(doc);
+    // Over intervals the `let`s have no type, and clippy then calls the
+    // last one before its return needless.
+    let (interval, allow) = if d.bounds {
+        (
+            quote! { #[allow(unused_imports)] use ::dalembert_runtime::interval::Interval; },
+            quote! { #[allow(unused_variables, clippy::approx_constant, clippy::let_and_return)] },
+        )
+    } else {
+        (
+            TokenStream::new(),
+            quote! { #[allow(unused_variables, clippy::approx_constant)] },
+        )
+    };
     quote! {
         #doc
         #[inline]
-        #[allow(unused_variables, clippy::approx_constant)]
-        pub fn #f(&self #args) -> #ret { #body #result }
+        #allow
+        pub fn #f(&self #args) -> #ret { #interval #body #result }
     }
 }
 
-/// `o0, o1, …` for the program's outputs, then `0.0` up to n entries.
-fn padded_outputs(p: &Program, n: usize) -> impl Iterator<Item = TokenStream> + '_ {
+/// `o0, o1, …` for the program's outputs, then `zero` up to n entries.
+fn padded_outputs(
+    p: &Program,
+    n: usize,
+    zero: TokenStream,
+) -> impl Iterator<Item = TokenStream> + '_ {
     (0..n).map(move |i| {
         if i < p.outputs {
             let o = format_ident!("o{i}");
             quote! { #o }
         } else {
-            quote! { 0.0 }
+            zero.clone()
         }
     })
 }

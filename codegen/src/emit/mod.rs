@@ -50,11 +50,15 @@ pub struct Options {
 
 /// What every emitting function sees: the model, the derivation, its plan
 /// and the emission options.
+#[derive(Clone, Copy)]
 struct Ctx<'a> {
     model: &'a Model,
     derivation: &'a Derivation,
     plan: &'a Plan<'a>,
     scalar: Scalar,
+    /// Programs are formatted over the runtime's `Interval` instead of the
+    /// scalar (a wall's `_bounds` functions; f64 models only).
+    bounds: bool,
 }
 
 impl Ctx<'_> {
@@ -77,6 +81,7 @@ pub fn file(d: &Derivation, options: Options) -> String {
         derivation: d,
         plan: &plan,
         scalar: options.scalar,
+        bounds: false,
     };
     let tokens = model_tokens(d);
     let file: syn::File = match syn::parse2(tokens) {

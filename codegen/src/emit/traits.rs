@@ -129,6 +129,15 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
         }
         None => (quote! { type SeriesScratch = (); }, TokenStream::new()),
     };
+    let bound = |what: &str| {
+        let arms = d.derivation.walls.iter().zip(&variants).map(|(w, v)| {
+            let f = format_ident!("{}_{what}_bounds", w.name);
+            quote! { Wall::#v => Some(self.#f(q)) }
+        });
+        quote! { match wall { #(#arms,)* } }
+    };
+    let (surface_bounds, normal_bounds) = (bound("surface"), bound("normal"));
+    let interval = quote! { ::dalembert_runtime::interval::Interval };
     quote! {
         #model_impl
         impl ::dalembert_runtime::Dynamics<#nl> for #ty {
@@ -142,6 +151,14 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
         impl ::dalembert_runtime::Surfaces<#nl> for #ty {
             #( #surfaces )*
             #surface_series
+            #[inline]
+            fn surface_bounds(&self, wall: Wall, q: &[#interval; #nl]) -> Option<#interval> {
+                #surface_bounds
+            }
+            #[inline]
+            fn normal_bounds(&self, wall: Wall, q: &[#interval; #nl]) -> Option<[#interval; #nl]> {
+                #normal_bounds
+            }
         }
     }
 }

@@ -14,6 +14,7 @@ mod tape;
 
 use std::cell::RefCell;
 
+use dalembert_runtime::interval::Interval;
 use dalembert_runtime::taylor::{Coefficients, MAX_ORDER, Series, SeriesWork};
 use dalembert_runtime::{__private, Dynamics, Model, Rows, Surfaces, Values, Walls};
 
@@ -30,6 +31,9 @@ struct Compiled {
     tape: Tape,
     /// Registers: parameters already in place, the rest filled per call.
     registers: RefCell<Vec<f64>>,
+    /// Registers of an evaluation over intervals (filled per call from
+    /// `registers`; room made by [`Compiled::with_bounds`]).
+    bounds: RefCell<Vec<Interval>>,
     /// For rows and values: how many are in use.
     rows: usize,
 }
@@ -43,6 +47,7 @@ impl Compiled {
         Self {
             tape,
             registers: RefCell::new(registers),
+            bounds: RefCell::new(Vec::new()),
             rows: f.rows,
         }
     }
@@ -65,6 +70,31 @@ impl Compiled {
         }
         self.tape.run(&mut r);
         read(self.tape.outputs(&r))
+    }
+
+    /// With room for an evaluation over intervals ([`Compiled::eval_bounds`]
+    /// then allocates nothing).
+    fn with_bounds(self) -> Self {
+        let room = self.registers.borrow().len();
+        *self.bounds.borrow_mut() = vec![Interval::point(0.0); room];
+        self
+    }
+
+    /// Runs on the parameters (as points) and `q`, a box of coordinates,
+    /// over intervals; hands the outputs to `read`.
+    fn eval_bounds<R>(&self, np: usize, q: &[Interval], read: impl FnOnce(&[Interval]) -> R) -> R {
+        let mut b = self.bounds.borrow_mut();
+        let r = self.registers.borrow();
+        if b.len() != r.len() {
+            b.resize(r.len(), Interval::point(0.0));
+        }
+        for (b, &x) in b.iter_mut().zip(r.iter()) {
+            *b = Interval::point(x);
+        }
+        let k = q.len().min(self.tape.inputs.saturating_sub(np));
+        b[np..np + k].copy_from_slice(&q[..k]);
+        self.tape.run(&mut b);
+        read(self.tape.outputs(&b))
     }
 
     fn set_parameter(&mut self, index: usize, value: f64) {
@@ -243,8 +273,8 @@ impl<const N: usize> Interpreted<N> {
             let wall_fn = |q: Quantity| find(&w.functions, q).ok_or_else(|| missing(q.spec().name));
             walls.push(WallPrograms {
                 name: w.name.clone(),
-                surface: wall_fn(Quantity::Surface)?,
-                normal: wall_fn(Quantity::Normal)?,
+                surface: wall_fn(Quantity::Surface)?.with_bounds(),
+                normal: wall_fn(Quantity::Normal)?.with_bounds(),
                 normal_velocity: wall_fn(Quantity::NormalVelocity)?,
                 surface_hessian: wall_fn(Quantity::SurfaceHessian)?,
                 rows: wall_fn(Quantity::WallRows)?,
@@ -528,6 +558,18 @@ impl<const N: usize> Surfaces<N> for Interpreted<N> {
     }
     fn surface_hessian(&self, wall: WallIndex, q: &[f64; N], v: &[f64; N]) -> Option<f64> {
         Some(self.scalar(&self.wall(wall).surface_hessian, q, v))
+    }
+    fn surface_bounds(&self, wall: WallIndex, q: &[Interval; N]) -> Option<Interval> {
+        let f = &self.wall(wall).surface;
+        Some(f.eval_bounds(self.np(), q, |o| {
+            o.first().copied().unwrap_or(Interval::point(0.0))
+        }))
+    }
+    fn normal_bounds(&self, wall: WallIndex, q: &[Interval; N]) -> Option<[Interval; N]> {
+        let f = &self.wall(wall).normal;
+        Some(f.eval_bounds(self.np(), q, |o| {
+            core::array::from_fn(|i| o.get(i).copied().unwrap_or(Interval::point(0.0)))
+        }))
     }
     fn surface_series(
         &self,

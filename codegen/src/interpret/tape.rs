@@ -14,7 +14,9 @@
 //! A copy (`t = o`) costs nothing: the slot just names the value's register.
 
 use std::collections::HashMap;
+use std::ops::{Add, Mul, Neg, Sub};
 
+use dalembert_runtime::interval::Interval;
 use dalembert_runtime::libm;
 
 use crate::program::machine::{Machine, Operand, lower};
@@ -231,6 +233,80 @@ impl Builder {
     }
 }
 
+/// What a register holds: an f64 (the values the emitted code computes,
+/// bit for bit), or an interval (bounds over a box of inputs, as the
+/// emitted `_bounds` functions compute them).
+pub(super) trait Register:
+    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Neg<Output = Self>
+{
+    /// A number.
+    fn number(x: f64) -> Self;
+    /// x · x · … · x, `n` factors.
+    fn power(self, n: u32) -> Self;
+    /// libm's pow(x, e).
+    fn pow(self, e: f64) -> Self;
+    /// 1 / x.
+    fn recip(self) -> Self;
+    /// √x.
+    fn sqrt(self) -> Self;
+    /// sin x and cos x.
+    fn sincos(self) -> (Self, Self);
+    /// The function `f` on this kind of value.
+    fn function(f: Func) -> fn(Self) -> Self;
+}
+
+impl Register for f64 {
+    fn number(x: f64) -> Self {
+        x
+    }
+    fn power(self, n: u32) -> Self {
+        let mut acc = self;
+        for _ in 1..n {
+            acc *= self;
+        }
+        acc
+    }
+    fn pow(self, e: f64) -> Self {
+        libm::pow(self, e)
+    }
+    fn recip(self) -> Self {
+        1.0 / self
+    }
+    fn sqrt(self) -> Self {
+        libm::sqrt(self)
+    }
+    fn sincos(self) -> (Self, Self) {
+        libm::sincos(self)
+    }
+    fn function(f: Func) -> fn(Self) -> Self {
+        f.libm()
+    }
+}
+
+impl Register for Interval {
+    fn number(x: f64) -> Self {
+        Interval::point(x)
+    }
+    fn power(self, n: u32) -> Self {
+        self.powi(n)
+    }
+    fn pow(self, e: f64) -> Self {
+        Interval::pow(self, e)
+    }
+    fn recip(self) -> Self {
+        Interval::recip(self)
+    }
+    fn sqrt(self) -> Self {
+        Interval::sqrt(self)
+    }
+    fn sincos(self) -> (Self, Self) {
+        Interval::sincos(self)
+    }
+    fn function(f: Func) -> fn(Self) -> Self {
+        f.interval()
+    }
+}
+
 impl Tape {
     /// Translates the instructions and orders them by level and kind.
     pub(super) fn new(p: &Program) -> Self {
@@ -291,9 +367,9 @@ impl Tape {
         }
     }
 
-    /// Runs the operations on `r` (a copy of [`Tape::init`] with the inputs
-    /// filled in).
-    pub(super) fn run(&self, r: &mut [f64]) {
+    /// Runs the operations on `r` (a copy of [`Tape::init`], as numbers or
+    /// points, with the inputs filled in).
+    pub(super) fn run<T: Register>(&self, r: &mut [T]) {
         let at = |i: u32| i as usize;
         for run in &self.runs {
             let ops = &self.ops[at(run.start)..at(run.end)];
@@ -312,7 +388,7 @@ impl Tape {
                     let args = &self.args[at(o.a)..at(o.a) + at(o.b)];
                     let mut acc = r[at(args[0])];
                     for &a in &args[1..] {
-                        acc += r[at(a)];
+                        acc = acc + r[at(a)];
                     }
                     r[at(o.d)] = acc
                 }),
@@ -320,27 +396,20 @@ impl Tape {
                     let args = &self.args[at(o.a)..at(o.a) + at(o.b)];
                     let mut acc = r[at(args[0])];
                     for &a in &args[1..] {
-                        acc *= r[at(a)];
+                        acc = acc * r[at(a)];
                     }
                     r[at(o.d)] = acc
                 }),
                 Kind::Neg => each!(|o| r[at(o.d)] = -r[at(o.a)]),
-                Kind::Set => each!(|o| r[at(o.d)] = self.numbers[at(o.b)]),
-                Kind::Power => each!(|o| {
-                    let x = r[at(o.a)];
-                    let mut acc = x;
-                    for _ in 1..o.b {
-                        acc *= x;
-                    }
-                    r[at(o.d)] = acc
-                }),
-                Kind::Pow => each!(|o| r[at(o.d)] = libm::pow(r[at(o.a)], self.numbers[at(o.b)])),
-                Kind::Recip => each!(|o| r[at(o.d)] = 1.0 / r[at(o.a)]),
-                Kind::Sqrt => each!(|o| r[at(o.d)] = libm::sqrt(r[at(o.a)])),
-                Kind::RecipSqrt => each!(|o| r[at(o.d)] = 1.0 / libm::sqrt(r[at(o.a)])),
-                Kind::SinCos => each!(|o| (r[at(o.d)], r[at(o.b)]) = libm::sincos(r[at(o.a)])),
+                Kind::Set => each!(|o| r[at(o.d)] = T::number(self.numbers[at(o.b)])),
+                Kind::Power => each!(|o| r[at(o.d)] = r[at(o.a)].power(o.b)),
+                Kind::Pow => each!(|o| r[at(o.d)] = r[at(o.a)].pow(self.numbers[at(o.b)])),
+                Kind::Recip => each!(|o| r[at(o.d)] = r[at(o.a)].recip()),
+                Kind::Sqrt => each!(|o| r[at(o.d)] = r[at(o.a)].sqrt()),
+                Kind::RecipSqrt => each!(|o| r[at(o.d)] = r[at(o.a)].sqrt().recip()),
+                Kind::SinCos => each!(|o| (r[at(o.d)], r[at(o.b)]) = r[at(o.a)].sincos()),
                 Kind::Call(f) => {
-                    let f = f.libm();
+                    let f = T::function(f);
                     each!(|o| r[at(o.d)] = f(r[at(o.a)]))
                 }
             }
@@ -351,7 +420,7 @@ impl Tape {
     }
 
     /// The outputs in a register file after [`Tape::run`].
-    pub(super) fn outputs<'r>(&self, r: &'r [f64]) -> &'r [f64] {
+    pub(super) fn outputs<'r, T>(&self, r: &'r [T]) -> &'r [T] {
         &r[self.out_base..self.out_base + self.outputs.len()]
     }
 }

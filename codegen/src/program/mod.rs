@@ -14,6 +14,8 @@ mod taylor;
 
 use std::collections::HashMap;
 
+use dalembert_runtime::interval::Interval;
+
 pub use elimination::Layout;
 pub use hoist::{Emit, Role, Split};
 pub use linear::{Entry, stored_signs};
@@ -113,6 +115,24 @@ impl Func {
             Self::Sinh => libm::sinh,
             Self::Cosh => libm::cosh,
             Self::Tanh => libm::tanh,
+        }
+    }
+
+    /// The runtime's interval function of that name: what the emitted
+    /// `_bounds` functions call.
+    pub fn interval(self) -> fn(Interval) -> Interval {
+        match self {
+            Self::Sin => Interval::sin,
+            Self::Cos => Interval::cos,
+            Self::Exp => Interval::exp,
+            Self::Log => Interval::log,
+            Self::Sqrt => Interval::sqrt,
+            Self::Atan => Interval::atan,
+            Self::Asin => Interval::asin,
+            Self::Acos => Interval::acos,
+            Self::Sinh => Interval::sinh,
+            Self::Cosh => Interval::cosh,
+            Self::Tanh => Interval::tanh,
         }
     }
 }
