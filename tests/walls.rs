@@ -19,8 +19,6 @@
 
 mod common;
 
-use std::path::Path;
-
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
     Collision, Integrator, Rk4, Settings, SimError, Simulator, State, Stats, Taylor,
@@ -30,13 +28,8 @@ use dalembert_codegen::interpret::Interpreted;
 
 use common::{dormand_prince, initial, lcg};
 
-/// The model file `tests/walls/{name}.toml`, interpreted.
 fn model<const N: usize>(name: &str) -> Interpreted<N> {
-    let file = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/walls")
-        .join(format!("{name}.toml"));
-    let d = dalembert_codegen::derive(&file).unwrap_or_else(|e| panic!("{name}: {e}"));
-    Interpreted::new(&d).unwrap_or_else(|e| panic!("{name}: {e}"))
+    common::wall_model(name)
 }
 
 /// How far beyond a wall a reported state may be: rounding (f at a

@@ -231,3 +231,12 @@ pub fn rustc(dir: &std::path::Path, source: &str, args: &[&str]) -> std::process
         .output()
         .expect("rustc runs")
 }
+
+/// The model file `tests/walls/{name}.toml`, interpreted.
+pub fn wall_model<const N: usize>(name: &str) -> dalembert_codegen::interpret::Interpreted<N> {
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/walls")
+        .join(format!("{name}.toml"));
+    let d = dalembert_codegen::derive(&file).unwrap_or_else(|e| panic!("{name}: {e}"));
+    dalembert_codegen::interpret::Interpreted::new(&d).unwrap_or_else(|e| panic!("{name}: {e}"))
+}

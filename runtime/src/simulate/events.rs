@@ -4,13 +4,15 @@
 //! Runge–Kutta step's dense output, or the polynomial of a step of
 //! Taylor's method whose walls' series disagree with f at its end).
 
+use super::enclosure::{Ends, polynomial_bounds};
 use super::integrator::{Method, RungeKutta, Trial};
 use super::phase::Phase;
 use super::thresholds::{
     RESOLVE_DEPTH, RESOLVED_DEFECT, RESOLVED_ROUNDING_ULPS, ROOT_ITERATIONS, SHORTEST_AIM_ULPS,
 };
 use super::{SimError, Simulator};
-use crate::taylor::Series;
+use crate::interval::Interval;
+use crate::taylor::{CAPACITY, MAX_ORDER, Series};
 use crate::{Surfaces, libm, linalg};
 
 /// The motion over one step, at θ ∈ [0, 1] of it.
@@ -22,6 +24,17 @@ pub(super) trait Path<const N: usize> {
     fn position(&self, theta: f64) -> [f64; N] {
         self.state(theta).q
     }
+
+    /// Bounds on q and on dq/dθ over θ ∈ [a, b], into `q` and `dq`, for
+    /// the coordinates `wanted` says (the others are left as they are).
+    fn bounds(
+        &self,
+        a: f64,
+        b: f64,
+        wanted: &[bool; N],
+        q: &mut [Interval; N],
+        dq: &mut [Interval; N],
+    );
 }
 
 /// A Runge–Kutta step of length `h` from `y0`: its ends, and its dense
@@ -52,6 +65,27 @@ impl<const N: usize> Path<N> for RkStep<'_, N> {
             self.trial.dense.position(theta, self.h)
         }
     }
+
+    fn bounds(
+        &self,
+        a: f64,
+        b: f64,
+        wanted: &[bool; N],
+        q: &mut [Interval; N],
+        dq: &mut [Interval; N],
+    ) {
+        let c = self.trial.dense.position_polynomial(self.h);
+        for i in (0..N).filter(|&i| wanted[i]) {
+            (q[i], dq[i]) = polynomial_bounds(c[i].len(), |k| c[i][k], a, b);
+            // The step's ends are its states, the dense output's ends
+            // within rounding of them: the hull holds both.
+            for (theta, y) in [(0.0, self.y0), (1.0, &self.trial.y1)] {
+                if a == theta || b == theta {
+                    q[i] = Interval::new(q[i].lo.min(y.q[i]), q[i].hi.max(y.q[i]));
+                }
+            }
+        }
+    }
 }
 
 /// A step of Taylor's method of length `tau` along `series`.
@@ -64,6 +98,26 @@ impl<const N: usize> Path<N> for SeriesStep<'_, N> {
     fn state(&self, theta: f64) -> Phase<N> {
         let (q, v) = self.series.state(theta * self.tau);
         Phase { q, v }
+    }
+
+    fn bounds(
+        &self,
+        a: f64,
+        b: f64,
+        wanted: &[bool; N],
+        q: &mut [Interval; N],
+        dq: &mut [Interval; N],
+    ) {
+        // The series in θ: coefficient k times τᵏ.
+        let n = self.series.order.min(MAX_ORDER) + 1;
+        let mut power = [1.0; CAPACITY];
+        for k in 1..n {
+            power[k] = power[k - 1] * self.tau;
+        }
+        for i in (0..N).filter(|&i| wanted[i]) {
+            let c = &self.series.q[i];
+            (q[i], dq[i]) = polynomial_bounds(n, |k| c[k] * power[k], a, b);
+        }
     }
 }
 
@@ -193,7 +247,49 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     /// f ≈ 0 moving away: it is met again only after f has been positive,
     /// which is also checked between samples through the top of the
     /// excursion.
+    ///
+    /// Samples can step over a dip narrower than their spacing whose
+    /// rates show nothing; so the stretch before what they find (the whole
+    /// step, or up to the crossing) is then proven clear on boxes that
+    /// enclose the motion ([`Simulator::earlier_crossing`]), and a crossing
+    /// found there comes first.
     fn wall_crossing(
+        &self,
+        k: usize,
+        path: &impl Path<N>,
+        t0: f64,
+        h: f64,
+    ) -> Result<Option<Met>, SimError<M::Wall>> {
+        let sampled = self.sampled_crossing(k, path, t0, h)?;
+        let end = match sampled {
+            None => 1.0,
+            Some(Met::Crossing(theta)) if theta > 0.0 => theta,
+            Some(_) => return Ok(sampled),
+        };
+        let on = OnStep {
+            model: self.model,
+            wall: self.model.walls()[k],
+            path,
+        };
+        let first = on.sample(0.0);
+        let ends = Ends {
+            f0: first.f,
+            leaving: self.departing & (1 << k) != 0 && first.f <= 0.0 && first.rate > 0.0,
+            end,
+            f_end: on.f(end),
+        };
+        Ok(match self.earlier_crossing(k, path, &ends) {
+            Some(b) => {
+                let theta = illinois(&|theta| on.f(theta), (b.a, b.fa), (b.b, b.fb));
+                Some(Met::Crossing(theta))
+            }
+            None => sampled,
+        })
+    }
+
+    /// What the samples of wall `k`'s f along the step meet first (see
+    /// [`Simulator::wall_crossing`]).
+    fn sampled_crossing(
         &self,
         k: usize,
         path: &impl Path<N>,

@@ -60,6 +60,7 @@
 mod collision;
 mod control;
 mod dense_output;
+mod enclosure;
 mod events;
 pub mod integrator;
 mod phase;

@@ -6,7 +6,8 @@
 //! the step's polynomial there, so a collision costs no further steps.
 
 use super::dense_output::LastStep;
-use super::events::{Scan, SeriesStep};
+use super::enclosure::Ends;
+use super::events::{Path, Scan, SeriesStep};
 use super::integrator::{Plan, Reach};
 use super::phase::Phase;
 use super::roots::first_root;
@@ -237,6 +238,31 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         Some(met)
     }
 
+    /// Whether no wall is crossed before τ = `end` on the step's
+    /// polynomial as far as the bounds on each wall's f can tell
+    /// ([`Simulator::earlier_crossing`]): the walls' series are searched
+    /// for roots at samples, and a series that is exact but flat at the
+    /// step's start (a narrow bump of the floor far ahead) shows nothing.
+    fn clear_before(&self, end: f64) -> bool {
+        let m = self.model;
+        let path = SeriesStep {
+            series: &self.series,
+            tau: end,
+        };
+        let (y0, q1) = (path.state(0.0), path.position(1.0));
+        m.walls().iter().enumerate().all(|(k, &wall)| {
+            let f0 = m.surface(wall, &y0.q);
+            let departing = self.departing & (1 << k) != 0;
+            let ends = Ends {
+                f0,
+                leaving: departing && f0 <= 0.0 && m.normal_velocity(wall, &y0.q, &y0.v) > 0.0,
+                end: 1.0,
+                f_end: m.surface(wall, &q1),
+            };
+            self.earlier_crossing(k, &path, &ends).is_none()
+        })
+    }
+
     /// The collision with wall `k` found at τ on the step's polynomial
     /// (where the state is `y` and the wall's f is `f`), moved onto the wall
     /// as f itself has it: Newton's method on f along the polynomial, as a
@@ -294,7 +320,9 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             None => limit.length(t0)?,
         };
         let mut y = finite(self.series.state(end), t0)?;
-        let agreed = self.agrees(found, &y.0, &y.1, limit.plan.method.tolerance);
+        let agreed = self
+            .agrees(found, &y.0, &y.1, limit.plan.method.tolerance)
+            .filter(|_| self.clear_before(end));
         if let (Some(c), Some(f)) = (found, agreed)
             && libm::fabs(f) > ON_WALL_ULPS * f64::EPSILON * c.scale
         {

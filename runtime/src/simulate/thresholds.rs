@@ -102,3 +102,13 @@ pub const ON_WALL_ULPS: f64 = 4.0;
 
 /// Newton (or bisection) steps at most on the step's polynomial.
 pub const SERIES_ROOT_ITERATIONS: usize = 100;
+
+/// Halvings at most of a stretch of a step that the bounds on a wall's f
+/// do not prove clear (`enclosure`): narrower stretches are left to the
+/// samples.
+pub const CLEAR_DEPTH: usize = 16;
+
+/// Boxes at most on which one wall is bounded along one step; past them
+/// the rest of the step is left to the samples (it takes a motion that
+/// grazes the wall along much of a step to need them).
+pub const CLEAR_BOXES: usize = 128;
