@@ -17,7 +17,7 @@
 //! `surface_bounds` is `None`).
 
 use super::Simulator;
-use super::events::Path;
+use super::path::Path;
 use super::thresholds::{CLEAR_BOXES, CLEAR_DEPTH};
 use crate::interval::Interval;
 use crate::{Surfaces, libm};

@@ -63,6 +63,7 @@ mod dense_output;
 mod enclosure;
 mod events;
 pub mod integrator;
+mod path;
 mod phase;
 mod projection;
 mod return_map;
@@ -82,8 +83,9 @@ use crate::Surfaces;
 use crate::dynamics::{accelerations, qdd};
 use crate::taylor::Series;
 use dense_output::LastStep;
-use events::{RkStep, Scan};
+use events::Scan;
 use integrator::{Engine, Method, RungeKutta};
+use path::RkStep;
 use phase::{Phase, norm};
 use thresholds::{ADMISSIBLE, MAX_WALLS, ON_WALL, TAYLOR_REACH};
 

@@ -7,8 +7,9 @@
 
 use super::dense_output::LastStep;
 use super::enclosure::Ends;
-use super::events::{Path, Scan, SeriesStep};
+use super::events::Scan;
 use super::integrator::{Plan, Reach};
+use super::path::{Path, SeriesStep};
 use super::phase::Phase;
 use super::roots::first_root;
 use super::thresholds::{
