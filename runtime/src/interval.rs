@@ -37,6 +37,7 @@ impl Interval {
     };
 
     /// [lo, hi]; `ENTIRE` if either is NaN or lo > hi.
+    #[inline]
     pub fn new(lo: f64, hi: f64) -> Self {
         if lo <= hi {
             Self { lo, hi }
@@ -46,6 +47,7 @@ impl Interval {
     }
 
     /// The single number x.
+    #[inline]
     pub fn point(x: f64) -> Self {
         Self::new(x, x)
     }
@@ -67,6 +69,7 @@ impl Interval {
 
     /// [lo, hi] one ulp wider at each end: a correctly rounded operation's
     /// bounds.
+    #[inline]
     fn rounded(lo: f64, hi: f64) -> Self {
         Self::new(lo.next_down(), hi.next_up())
     }
@@ -273,6 +276,7 @@ impl Interval {
 
 impl Add for Interval {
     type Output = Self;
+    #[inline]
     fn add(self, b: Self) -> Self {
         Self::rounded(self.lo + b.lo, self.hi + b.hi)
     }
@@ -280,6 +284,7 @@ impl Add for Interval {
 
 impl Sub for Interval {
     type Output = Self;
+    #[inline]
     fn sub(self, b: Self) -> Self {
         Self::rounded(self.lo - b.hi, self.hi - b.lo)
     }
@@ -287,6 +292,7 @@ impl Sub for Interval {
 
 impl Neg for Interval {
     type Output = Self;
+    #[inline]
     fn neg(self) -> Self {
         Self::new(-self.hi, -self.lo)
     }
@@ -294,6 +300,7 @@ impl Neg for Interval {
 
 impl Mul for Interval {
     type Output = Self;
+    #[inline]
     fn mul(self, b: Self) -> Self {
         let p = [
             self.lo * b.lo,

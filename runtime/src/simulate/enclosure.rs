@@ -134,11 +134,13 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         }; CLEAR_DEPTH + 2];
         let mut top = 1;
         let mut boxes = 0;
-        // The box of the whole stretch first; afterwards only the
-        // coordinates f depends on there (df not zero on it) are bounded
-        // again: the rest keep the whole stretch's bounds, which hold them.
+        // Only the coordinates f depends on are bounded: those whose entry
+        // of df is not exactly zero over every q. f does not change with
+        // the others, so any value of theirs (0) gives its range.
         let (mut q, mut dq) = ([Interval::point(0.0); N], [Interval::point(0.0); N]);
-        let mut wanted = [true; N];
+        let wanted = m
+            .normal_bounds(wall, &[Interval::ENTIRE; N])
+            .map_or([true; N], |g| g.map(|g| !(g.lo == 0.0 && g.hi == 0.0)));
         while top > 0 {
             top -= 1;
             let s = stack[top];
@@ -151,16 +153,10 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             if bound.lo > 0.0 {
                 continue;
             }
-            let normal = m.normal_bounds(wall, &q);
-            if boxes == 1
-                && let Some(g) = &normal
-            {
-                for (w, g) in wanted.iter_mut().zip(g) {
-                    *w = !(g.lo == 0.0 && g.hi == 0.0);
-                }
-            }
-            if let Some(g) = normal {
-                let rate = (g.iter().zip(&dq)).fold(Interval::point(0.0), |r, (g, d)| r + *g * *d);
+            if let Some(g) = m.normal_bounds(wall, &q) {
+                let rate = (g.iter().zip(&dq).zip(&wanted))
+                    .filter(|(_, w)| **w)
+                    .fold(Interval::point(0.0), |r, ((g, d), _)| r + *g * *d);
                 let rises_from_clear = s.fa > 0.0 || (s.a == 0.0 && ends.leaving);
                 if rate.lo > 0.0 && rises_from_clear {
                     continue;

@@ -153,54 +153,54 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         t0: f64,
         h: f64,
     ) -> Result<Option<Met>, SimError<M::Wall>> {
-        let sampled = self.sampled_crossing(k, path, t0, h)?;
-        let end = match sampled {
-            None => 1.0,
-            Some(Met::Crossing(theta)) if theta > 0.0 => theta,
-            Some(_) => return Ok(sampled),
-        };
         let on = OnStep {
             model: self.model,
             wall: self.model.walls()[k],
             path,
         };
-        let first = on.sample(0.0);
+        let sampled = self.sampled_crossing(k, &on, t0, h)?;
+        let (end, f_end) = match sampled.met {
+            None => (1.0, sampled.f_last),
+            Some(Met::Crossing(theta)) if theta > 0.0 => (theta, on.f(theta)),
+            Some(_) => return Ok(sampled.met),
+        };
         let ends = Ends {
-            f0: first.f,
-            leaving: self.departing & (1 << k) != 0 && first.f <= 0.0 && first.rate > 0.0,
+            f0: sampled.f0,
+            leaving: sampled.leaving,
             end,
-            f_end: on.f(end),
+            f_end,
         };
         Ok(match self.earlier_crossing(k, path, &ends) {
             Some(b) => {
                 let theta = illinois(&|theta| on.f(theta), (b.a, b.fa), (b.b, b.fb));
                 Some(Met::Crossing(theta))
             }
-            None => sampled,
+            None => sampled.met,
         })
     }
 
     /// What the samples of wall `k`'s f along the step meet first (see
     /// [`Simulator::wall_crossing`]).
-    fn sampled_crossing(
+    fn sampled_crossing<P: Path<N>>(
         &self,
         k: usize,
-        path: &impl Path<N>,
+        on: &OnStep<'_, M, P, N>,
         t0: f64,
         h: f64,
-    ) -> Result<Option<Met>, SimError<M::Wall>> {
-        let on = OnStep {
-            model: self.model,
-            wall: self.model.walls()[k],
-            path,
-        };
+    ) -> Result<Sampled, SimError<M::Wall>> {
         let n = self.settings.samples + 1;
         let first = on.sample(0.0);
         let leaving = self.departing & (1 << k) != 0 && first.f <= 0.0 && first.rate > 0.0;
+        let sampled = |met, last: &Sample| Sampled {
+            met,
+            f0: first.f,
+            leaving,
+            f_last: last.f,
+        };
         if !leaving && first.f <= 0.0 {
             // At or beyond the wall at the step's start and not leaving it
             // (a projection can move q by rounding-sized amounts).
-            return Ok(Some(Met::Crossing(0.0)));
+            return Ok(sampled(Some(Met::Crossing(0.0)), &first));
         }
         let mut walk = Walk {
             prev: first,
@@ -209,16 +209,16 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         for j in 1..=n {
             let now = on.sample(j as f64 / n as f64);
             if !explained(&walk.prev, &now, h) {
-                match walk.refined(&on, now, t0, h)? {
-                    Some(met) => return Ok(Some(met)),
+                match walk.refined(on, now, t0, h)? {
+                    Some(met) => return Ok(sampled(Some(met), &walk.prev)),
                     None => continue,
                 }
             }
-            if let Some(theta) = walk.to(&on, now, t0, h)? {
-                return Ok(Some(Met::Crossing(theta)));
+            if let Some(theta) = walk.to(on, now, t0, h)? {
+                return Ok(sampled(Some(Met::Crossing(theta)), &walk.prev));
             }
         }
-        Ok(None)
+        Ok(sampled(None, &walk.prev))
     }
 }
 
@@ -253,6 +253,16 @@ impl Unresolved {
             0.5 * self.to * h
         }
     }
+}
+
+/// What the samples of one wall's f along a step found: what they met
+/// first, f at θ = 0 and whether the motion is leaving the wall there, and
+/// the last sample's f (at θ = 1 where nothing was met).
+struct Sampled {
+    met: Option<Met>,
+    f0: f64,
+    leaving: bool,
+    f_last: f64,
 }
 
 /// One wall's verdict on a step.

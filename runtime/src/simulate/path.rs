@@ -7,7 +7,7 @@ use super::enclosure::polynomial_bounds;
 use super::integrator::Trial;
 use super::phase::Phase;
 use crate::interval::Interval;
-use crate::taylor::{CAPACITY, MAX_ORDER, Series};
+use crate::taylor::{CAPACITY, MAX_ORDER, Series, degree};
 
 /// The motion over one step, at θ ∈ [0, 1] of it.
 pub(super) trait Path<const N: usize> {
@@ -94,6 +94,12 @@ impl<const N: usize> Path<N> for SeriesStep<'_, N> {
         Phase { q, v }
     }
 
+    fn position(&self, theta: f64) -> [f64; N] {
+        let tau = theta * self.tau;
+        let order = self.series.order;
+        core::array::from_fn(|i| crate::taylor::eval(&self.series.q[i], order, tau))
+    }
+
     fn bounds(
         &self,
         a: f64,
@@ -102,15 +108,19 @@ impl<const N: usize> Path<N> for SeriesStep<'_, N> {
         q: &mut [Interval; N],
         dq: &mut [Interval; N],
     ) {
-        // The series in θ: coefficient k times τᵏ.
-        let n = self.series.order.min(MAX_ORDER) + 1;
-        let mut power = [1.0; CAPACITY];
-        for k in 1..n {
-            power[k] = power[k - 1] * self.tau;
-        }
+        // The series in θ: coefficient k times τᵏ, up to the last that is
+        // not zero (a free flight's height is a parabola).
+        let order = self.series.order.min(MAX_ORDER);
+        let mut scaled = [0.0; CAPACITY];
         for i in (0..N).filter(|&i| wanted[i]) {
             let c = &self.series.q[i];
-            (q[i], dq[i]) = polynomial_bounds(n, |k| c[k] * power[k], a, b);
+            let n = degree(c, order) + 1;
+            let mut power = 1.0;
+            for (d, c) in scaled.iter_mut().zip(&c[..n]) {
+                *d = c * power;
+                power *= self.tau;
+            }
+            (q[i], dq[i]) = polynomial_bounds(n, |k| scaled[k], a, b);
         }
     }
 }

@@ -9,7 +9,7 @@ use super::dense_output::LastStep;
 use super::enclosure::Ends;
 use super::events::Scan;
 use super::integrator::{Plan, Reach};
-use super::path::{Path, SeriesStep};
+use super::path::SeriesStep;
 use super::phase::Phase;
 use super::roots::first_root;
 use super::thresholds::{
@@ -244,13 +244,14 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     /// ([`Simulator::earlier_crossing`]): the walls' series are searched
     /// for roots at samples, and a series that is exact but flat at the
     /// step's start (a narrow bump of the floor far ahead) shows nothing.
-    fn clear_before(&self, end: f64) -> bool {
+    /// `q1` is q at τ = `end`; the step starts at `self.state`.
+    fn clear_before(&self, end: f64, q1: &[f64; N]) -> bool {
         let m = self.model;
         let path = SeriesStep {
             series: &self.series,
             tau: end,
         };
-        let (y0, q1) = (path.state(0.0), path.position(1.0));
+        let y0 = &self.state;
         m.walls().iter().enumerate().all(|(k, &wall)| {
             let f0 = m.surface(wall, &y0.q);
             let departing = self.departing & (1 << k) != 0;
@@ -258,7 +259,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
                 f0,
                 leaving: departing && f0 <= 0.0 && m.normal_velocity(wall, &y0.q, &y0.v) > 0.0,
                 end: 1.0,
-                f_end: m.surface(wall, &q1),
+                f_end: m.surface(wall, q1),
             };
             self.earlier_crossing(k, &path, &ends).is_none()
         })
@@ -323,7 +324,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         let mut y = finite(self.series.state(end), t0)?;
         let agreed = self
             .agrees(found, &y.0, &y.1, limit.plan.method.tolerance)
-            .filter(|_| self.clear_before(end));
+            .filter(|_| self.clear_before(end, &y.0));
         if let (Some(c), Some(f)) = (found, agreed)
             && libm::fabs(f) > ON_WALL_ULPS * f64::EPSILON * c.scale
         {
