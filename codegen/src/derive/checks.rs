@@ -15,12 +15,14 @@ use std::ops::Range;
 
 use symbolica::prelude::*;
 
+use super::budget::Over;
 use super::build::Differentiate;
 use super::evaluate::program;
+use super::lower::Lowering;
 use super::mechanics::Raw;
 use super::sample::onto;
 use super::symbols::Symbols;
-use super::{Field, Rat, budget, is_zero, rows_matrix};
+use super::{Rat, budget, is_zero};
 use crate::diag::{Collector, ErrorKind, Reported};
 use crate::ir::Wall;
 use crate::program::Program;
@@ -199,20 +201,14 @@ pub fn wall_hypotheses(
     b: &[Vec<Rat>],
     a: &[Vec<Rat>],
     normal: &[Rat],
-    field: &Field,
-) {
-    let n = normal.len();
+    low: &Lowering,
+) -> Result<(), Over> {
     let at = "generic parameters and configurations".to_string();
-    let rank = |rows: &[Vec<Rat>]| -> usize {
-        if rows.is_empty() {
-            return 0;
-        }
-        rows_matrix(rows, n, field).map(|m| m.rank()).unwrap_or(0)
-    };
-    let rb = rank(b);
+    let rank = |rows: &[Vec<Rat>]| low.rank(rows);
+    let rb = rank(b)?;
     let mut ba = b.to_vec();
     ba.extend(a.iter().cloned());
-    if rank(&ba) > rb {
+    if rank(&ba)? > rb {
         cx.error(
             ErrorKind::Hypothesis {
                 wall: w.name.clone(),
@@ -224,10 +220,10 @@ pub fn wall_hypotheses(
             Some(w.span.clone()),
         );
     }
-    let ra = rank(a);
+    let ra = rank(a)?;
     let mut an = a.to_vec();
     an.push(normal.to_vec());
-    if rank(&an) == ra {
+    if rank(&an)? == ra {
         cx.error(
             ErrorKind::Hypothesis {
                 wall: w.name.clone(),
@@ -237,6 +233,7 @@ pub fn wall_hypotheses(
             Some(w.span.clone()),
         );
     }
+    Ok(())
 }
 
 /// What [`on_wall`] evaluates: f, df, h and the rows of A and B.

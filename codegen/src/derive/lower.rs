@@ -152,7 +152,13 @@ impl Lowering {
     /// by them are equal. Combinations that vanish only by the identities
     /// after elimination are not seen (the note in `docs/model-format.md`).
     pub fn to_rat(&self, a: &Atom) -> Result<Rat, Over> {
-        let r = self.rat(&self.lower(a));
+        self.reduce_rat(self.rat(&self.lower(a)))
+    }
+
+    /// A rational function of the lowered symbols with its numerator and
+    /// denominator reduced by the identities, as [`Lowering::to_rat`]
+    /// gives one.
+    fn reduce_rat(&self, r: Rat) -> Result<Rat, Over> {
         if self.pairs.is_empty() {
             return Ok(r);
         }
@@ -163,6 +169,16 @@ impl Lowering {
             return Ok(r);
         }
         Ok(self.rat(&(num / den)))
+    }
+
+    /// The rank of `rows` (entries from [`Lowering::to_rat`]) with the
+    /// identities holding ([`Echelon`]).
+    pub fn rank(&self, rows: &[Vec<Rat>]) -> Result<usize, Over> {
+        let mut echelon = Echelon::new(self);
+        for row in rows {
+            echelon.insert(row)?;
+        }
+        Ok(echelon.rank())
     }
 
     /// Reduces a polynomial modulo c² + s² − 1 for every sin/cos pair and
@@ -237,6 +253,62 @@ impl Lowering {
         } else {
             terms.join(" + ")
         })
+    }
+}
+
+/// Rows brought to echelon form one at a time, over the rational
+/// functions of a [`Lowering`]'s symbols with sin² + cos² = 1 and
+/// cosh² − sinh² = 1 holding: every entry an elimination step makes is
+/// reduced by the identities, whose reduced numerators are a normal form
+/// (degree at most 1 in each cos and cosh), so a combination of rows that
+/// vanishes only by the identities is found to vanish. (An exact rank over
+/// the field that treats sin and cos as independent symbols misses such
+/// combinations: a rolling disk's rows and its rough wall's contact rows
+/// are dependent only through them.)
+pub struct Echelon<'l> {
+    low: &'l Lowering,
+    /// The rows so far, each with the column of its pivot; every row is
+    /// zero in the pivot columns of the rows before it.
+    rows: Vec<(usize, Vec<Rat>)>,
+}
+
+impl<'l> Echelon<'l> {
+    pub fn new(low: &'l Lowering) -> Self {
+        Self {
+            low,
+            rows: Vec::new(),
+        }
+    }
+
+    /// Adds `row` (entries from [`Lowering::to_rat`]) if it is independent
+    /// of the rows so far; whether it was.
+    pub fn insert(&mut self, row: &[Rat]) -> Result<bool, Over> {
+        let mut row = row.to_vec();
+        for (p, pivot) in &self.rows {
+            if row[*p].numerator.is_zero() {
+                continue;
+            }
+            let factor = row[*p].to_expression() / pivot[*p].to_expression();
+            for (x, y) in row.iter_mut().zip(pivot) {
+                if y.numerator.is_zero() {
+                    continue;
+                }
+                let e = x.to_expression() - &factor * y.to_expression();
+                *x = self.low.reduce_rat(self.low.rat(&e))?;
+            }
+        }
+        Ok(match row.iter().position(|x| !x.numerator.is_zero()) {
+            Some(p) => {
+                self.rows.push((p, row));
+                true
+            }
+            None => false,
+        })
+    }
+
+    /// How many independent rows it holds.
+    pub fn rank(&self) -> usize {
+        self.rows.len()
     }
 }
 
@@ -445,6 +517,34 @@ mod tests {
 
     /// Zero only by sin² + cos² = 1 or cosh² − sinh² = 1, powers
     /// included; and near misses that are not zero.
+    /// (cos x, sin x) and cos x times it, whose first entry reduces to
+    /// 1 − sin² x: dependent only through sin² + cos² = 1 once elimination
+    /// has combined them (the plain rank over the rational functions of
+    /// sin and cos as independent symbols is 2). Rows that are independent
+    /// stay so.
+    #[test]
+    fn rows_dependent_through_the_identities_after_elimination() {
+        crate::lock::acquire().unwrap();
+        let _ns = Namespace::enter("lower test");
+        let x = own_symbol("x");
+        let s = function!(Symbol::SIN, Atom::from(x));
+        let c = function!(Symbol::COS, Atom::from(x));
+        let rank = |rows: Vec<Vec<Atom>>| {
+            let all: Vec<Atom> = rows.iter().flatten().map(prepared).collect();
+            let low = Lowering::of(&all, vec![x]);
+            let rats: Vec<Vec<Rat>> = (rows.iter())
+                .map(|r| r.iter().map(|a| low.to_rat(a).unwrap()).collect())
+                .collect();
+            let field = super::super::Field::from_poly(&rats[0][0].numerator);
+            let plain = super::super::rows_matrix(&rats, 2, &field).unwrap().rank();
+            (low.rank(&rats).unwrap(), plain)
+        };
+        let dependent = vec![vec![c.clone(), s.clone()], vec![&c * &c, &s * &c]];
+        assert_eq!(rank(dependent), (1, 2));
+        let independent = vec![vec![c.clone(), s.clone()], vec![s.clone(), c.clone()]];
+        assert_eq!(rank(independent).0, 2);
+    }
+
     #[test]
     fn squares_of_pairs_reduce() {
         for (a, b) in [

@@ -9,7 +9,7 @@ use std::ops::Range;
 use symbolica::prelude::*;
 
 use super::build::Differentiate;
-use super::lower::{self, Lowering};
+use super::lower::{self, Echelon, Lowering};
 use super::symbols::Symbols;
 use super::{Field, Rat, is_zero, rows_matrix};
 use super::{budget, checks};
@@ -362,7 +362,8 @@ pub fn exact(
                 .collect::<Result<Vec<Rat>, _>>()
                 .map_err(|o| o.report(cx, span, &lower::reduced("a constraint row")))
         })
-        .collect::<Result<_, _>>()?;
+        .collect::<Result<Vec<Vec<Rat>>, _>>()?;
+    independent_constraints(sym, low, &a, cx)?;
     let g = (raw.g.iter())
         .map(|r| r.iter().map(|x| low.reduce(x)).collect())
         .collect::<Result<Vec<Vec<Atom>>, _>>()
@@ -437,6 +438,36 @@ fn off_diagonal_entries(g: &[Vec<Atom>]) -> usize {
                 .count()
         })
         .sum()
+}
+
+/// An error at each row of A that is a combination of the rows before it
+/// (exactly, sin² + cos² = 1 and cosh² − sinh² = 1 holding: a row may be
+/// another's multiple only through them): such a row constrains nothing
+/// more, and the equations of motion with it have no unique multipliers
+/// (the derivation stops there).
+fn independent_constraints(
+    sym: &Symbols,
+    low: &Lowering,
+    a: &[Vec<Rat>],
+    cx: &mut Collector,
+) -> Result<(), Reported> {
+    let m = sym.model;
+    let mut echelon = Echelon::new(low);
+    let mut refused = None;
+    for (row, declared) in a.iter().zip(m.holonomic.iter().chain(&m.constraints)) {
+        let independent = echelon
+            .insert(row)
+            .map_err(|o| o.report(cx, &declared.span, &lower::reduced("a constraint row")))?;
+        if !independent {
+            refused = Some(cx.error(
+                ErrorKind::Structure(
+                    "this constraint is a combination of the ones before it (holonomic constraints count by their differentials, and sin² + cos² = 1 may be needed to see it): it constrains nothing more; remove it".into(),
+                ),
+                Some(declared.span.clone()),
+            ));
+        }
+    }
+    refused.map_or(Ok(()), Err)
 }
 
 /// q̈ of the equations of motion in closed form, where G⁻¹ is exact and the

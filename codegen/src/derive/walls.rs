@@ -9,7 +9,7 @@ use super::budget::Over;
 use super::build::Differentiate;
 use super::checks::{self, WallRows};
 use super::elimination;
-use super::lower::{self, Lowering};
+use super::lower::{self, Echelon, Lowering};
 use super::mechanics::{Exact, Raw, RawWall};
 use super::output::{Form, Function, Geometry, Projection, WallDerivation};
 use super::symbols::Symbols;
@@ -211,7 +211,8 @@ fn rows(
             .map_err(|o| reduced(o, cx, &w.span, "a contact row"))?;
         candidates.push((r, format!("contact constraint {}", k + 1)));
     }
-    let (kept, dropped) = independent_rows(&candidates, n, &exact.field);
+    let (kept, dropped) =
+        independent_rows(&candidates, low).map_err(|o| reduced(o, cx, &w.span, "the rows of B"))?;
     let b: Vec<Vec<Rat>> = kept.iter().map(|(r, _)| r.clone()).collect();
     let spans = steady(
         c,
@@ -221,7 +222,8 @@ fn rows(
     )
     .map_err(|o| reduced(o, cx, &w.span, "the rows of B"))?;
     let dropped: Vec<String> = dropped.into_iter().map(|(_, o)| o).collect();
-    checks::wall_hypotheses(cx, w, &b, &exact.a, &candidates[0].0, &exact.field);
+    checks::wall_hypotheses(cx, w, &b, &exact.a, &candidates[0].0, low)
+        .map_err(|o| reduced(o, cx, &w.span, "the rows of B"))?;
     if kept.is_empty() {
         return Ok(None);
     }
@@ -521,28 +523,24 @@ fn projector(g_inv: &Matrix<Field>, b: &Matrix<Field>) -> Option<Matrix<Field>> 
     Some(&(&x * &m_inv) * b)
 }
 
-/// Keeps each candidate row that raises the rank (exactly, over the field of
-/// rational functions), in order; returns the kept rows and the descriptions
-/// of the dropped ones.
+/// Keeps each candidate row that raises the rank (exactly, the identities
+/// holding: [`Echelon`]), in order; returns the kept rows and the dropped
+/// ones, with their descriptions.
 #[allow(clippy::type_complexity)]
 fn independent_rows(
     candidates: &[(Vec<Rat>, String)],
-    n: usize,
-    field: &Field,
-) -> (Vec<(Vec<Rat>, String)>, Vec<(Vec<Rat>, String)>) {
-    let mut kept: Vec<(Vec<Rat>, String)> = Vec::new();
-    let mut dropped = Vec::new();
+    low: &Lowering,
+) -> Result<(Vec<(Vec<Rat>, String)>, Vec<(Vec<Rat>, String)>), Over> {
+    let mut echelon = Echelon::new(low);
+    let (mut kept, mut dropped) = (Vec::new(), Vec::new());
     for (row, origin) in candidates {
-        let mut trial: Vec<Vec<Rat>> = kept.iter().map(|(r, _)| r.clone()).collect();
-        trial.push(row.clone());
-        let rank = rows_matrix(&trial, n, field).map(|m| m.rank()).unwrap_or(0);
-        if rank == trial.len() {
+        if echelon.insert(row)? {
             kept.push((row.clone(), origin.clone()));
         } else {
             dropped.push((row.clone(), origin.clone()));
         }
     }
-    (kept, dropped)
+    Ok((kept, dropped))
 }
 
 /// Whether the kept rows span every dropped row with coefficients free of
