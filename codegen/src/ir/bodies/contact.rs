@@ -137,7 +137,14 @@ impl Layer<'_> {
     /// the normal's largest axis `k` (with the normal's row, they span all
     /// three); identically zero rows left out.
     fn no_slip(body: &Body, offset: &Vec3, k: Option<usize>) -> Vec<Sym> {
-        let point = plus(&body.velocity, &cross(&body.omega, offset));
+        Self::no_slip_scaled(body, &int(1), offset, k)
+    }
+
+    /// [`Layer::no_slip`] for the rows `factor` times the contact point's
+    /// velocity, which is then `factor` Ṡ + ω × `offset` (the offset
+    /// scaled by `factor` too).
+    fn no_slip_scaled(body: &Body, factor: &Sym, offset: &Vec3, k: Option<usize>) -> Vec<Sym> {
+        let point = plus(&scale(factor, &body.velocity), &cross(&body.omega, offset));
         (0..3)
             .filter(|&i| Some(i) != k)
             .map(|i| point[i].clone())
@@ -436,11 +443,17 @@ impl Layer<'_> {
             return;
         };
         let r = body.radius.clone().unwrap_or(int(0));
-        let (surface, offset, k) = match (&shape, &body.disk) {
+        // The surface, the contact point's offset from the centre, the
+        // factor the contact point's velocity is scaled by in the rows,
+        // and the axis whose component is left out of them.
+        let (surface, offset, factor, k) = match (&shape, &body.disk) {
             // A disk (radius R, axis e) meets the plane at its rim's point
             // nearest it, R u from the centre, u = w/|w|, w = n − (n·e)e:
             // f = n·S − offset − R|w|. (Where e is along n the disk lies
-            // flat against the wall and f has no derivative.)
+            // flat against the wall and f has no derivative.) Its rough
+            // rows are |w| times the point's velocity, |w| Ṡ − R ω × w:
+            // the same rows, and the exact rank test sees them dependent
+            // with a rolling disk's rows (divided by the root, it does not).
             (Shape::Plane(n, offset, k), Some((radius, e))) => {
                 let (w, size2) = toward(n, e);
                 let size = call(Function::Sqrt, size2);
@@ -449,7 +462,8 @@ impl Layer<'_> {
                         sub(dot(n, &body.position), offset.clone()),
                         mul([radius.clone(), size.clone()]),
                     ),
-                    scale(&div(mul([int(-1), radius.clone()]), size), &w),
+                    scale(&mul([int(-1), radius.clone()]), &w),
+                    size,
                     Some(*k),
                 )
             }
@@ -463,6 +477,7 @@ impl Layer<'_> {
             (Shape::Plane(n, offset, k), None) => (
                 sub(sub(dot(n, &body.position), offset.clone()), r.clone()),
                 scale(&mul([int(-1), r.clone()]), n),
+                int(1),
                 Some(*k),
             ),
             (Shape::Round(c, axis, big), None) => {
@@ -473,21 +488,11 @@ impl Layer<'_> {
                     mul([int(2), reach.clone()]),
                 );
                 // On the wall |d| = R − r: the contact point is r d/(R − r) away.
-                (f, scale(&div(r.clone(), reach), &d), None)
+                (f, scale(&div(r.clone(), reach), &d), int(1), None)
             }
         };
-        if rough && body.disk.is_some() {
-            // Its rows would be the rim point's velocity through the root
-            // |w|, in which the exact rank test cannot see that they and a
-            // rolling disk's rows are dependent.
-            self.cx.error(
-                structure("a rough wall for a disk is not derived yet: write its `surface` and `contact` by hand, or make it `smooth`"),
-                w.law.as_ref().map(|l| l.span()),
-            );
-            return;
-        }
         let rows = if rough {
-            if body.radius.is_none() {
+            if body.radius.is_none() && body.disk.is_none() {
                 self.cx.error(
                     structure(format!(
                         "a rough wall holds the contact point of the body's sphere; body `{}` has no `radius`",
@@ -497,7 +502,7 @@ impl Layer<'_> {
                 );
                 return;
             }
-            Self::no_slip(&body, &offset, k)
+            Self::no_slip_scaled(&body, &factor, &offset, k)
         } else {
             Vec::new()
         };
