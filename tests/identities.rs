@@ -172,4 +172,36 @@ mod property {
             prop_assert_eq!(same(&triple, &q), Ok(true), "{}", triple);
         }
     }
+
+    /// A sum of one to three terms k·sin(z)ⁱ·cos(z)ʲ, j ≥ 1 (k ≠ 0).
+    fn in_z() -> impl Strategy<Value = String> {
+        let k = prop_oneof![-3i32..=-1, 1i32..=3];
+        let term =
+            (k, 0u32..3, 1u32..4).prop_map(|(k, i, j)| format!("({k})*sin(z)^{i}*cos(z)^{j}"));
+        proptest::collection::vec(term, 1..=3).prop_map(|t| t.join(" + "))
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(16))]
+
+        /// A second constraint row p(z) times the first, each entry
+        /// reduced by sin² + cos² = 1 before the rank is taken (so that
+        /// the rows are proportional only through the identity), is
+        /// refused as a combination of the first; with ż added it is
+        /// independent and not refused as dependent. (It may still be
+        /// refused by a later solve whose plain pivots vanish by the
+        /// identities, with an error that says so: p = −2 cos³ z is, in the
+        /// collision map on admissible velocities.)
+        #[test]
+        fn multiples_of_a_row_through_the_identities_are_dependent(p in in_z()) {
+            let first = "cos(z)*x_dot + sin(z)*y_dot";
+            let multiple = format!("({p})*cos(z)*x_dot + ({p})*sin(z)*y_dot");
+            prop_assert!(super::second_row_refused(&[first, &multiple]), "{}", multiple);
+            let independent = format!("{multiple} + z_dot");
+            let refused = super::attempt(&super::model(&[first, &independent]))
+                .err()
+                .unwrap_or_default();
+            prop_assert!(!refused.contains("combination"), "{}", refused);
+        }
+    }
 }
