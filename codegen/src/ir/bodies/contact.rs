@@ -443,9 +443,9 @@ impl Layer<'_> {
             return;
         };
         let r = body.radius.clone().unwrap_or(int(0));
-        // The surface, the contact point's offset from the centre, the
-        // factor the contact point's velocity is scaled by in the rows,
-        // and the axis whose component is left out of them.
+        // The surface; the factor the contact point's velocity is scaled
+        // by in the rough rows, and the point's offset from the centre
+        // times that factor; the axis whose component the rows leave out.
         let (surface, offset, factor, k) = match (&shape, &body.disk) {
             // A disk (radius R, axis e) meets the plane at its rim's point
             // nearest it, R u from the centre, u = w/|w|, w = n − (n·e)e:
@@ -495,7 +495,7 @@ impl Layer<'_> {
             if body.radius.is_none() && body.disk.is_none() {
                 self.cx.error(
                     structure(format!(
-                        "a rough wall holds the contact point of the body's sphere; body `{}` has no `radius`",
+                        "a rough wall holds the point of the body's contact shape that touches it; body `{}` has none (give it a `radius` or a `disk`)",
                         body_name.get_ref()
                     )),
                     w.law.as_ref().map(|l| l.span()),
