@@ -61,14 +61,14 @@ fn one<M: Surfaces<N> + Default, const N: usize>(c: &mut Criterion<ThreadCpuTime
 }
 
 /// §3.2.1's bounce (`ball_bounce` from its file's start, N = 6) alone and
-/// with Φ followed after every step: through 10⁴ bounces by Dormand–Prince
+/// with Φ followed after every step, or ∂x/∂r (the ball's radius): through 10⁴ bounces by Dormand–Prince
 /// (its default tolerance) and 10³ by RK4 (step 10⁻³), whose steps Φ is
 /// carried through, and through 100 bounces by Taylor's method, along
 /// whose steps Φ is integrated at rtol 1e-10.
 fn variational(c: &mut Criterion<ThreadCpuTime>) {
     use dalembert::models::BallBounce;
-    use dalembert::runtime::simulate::Variational;
     use dalembert::runtime::simulate::{Integrator, Rk4, Settings, Simulator, State, Taylor};
+    use dalembert::runtime::simulate::{ParameterSensitivity, Variational};
     let m = BallBounce::default();
     let start = State {
         t: 0.0,
@@ -84,29 +84,42 @@ fn variational(c: &mut Criterion<ThreadCpuTime>) {
         ("rk4", with(Integrator::Rk4(Rk4 { step: 1e-3 })), 1_000),
         ("taylor", with(Integrator::Taylor(Taylor::default())), 100),
     ];
+    // ∂/∂r: the radius moves the floor's f and the map.
+    let dp = [0.0, 1.0, 0.0, 0.0];
+    assert_eq!(m.parameter_names()[1], "r");
     for (name, settings, bounces) in methods {
-        let run = |follow: bool| {
+        // (follow Φ, follow ∂x/∂r)
+        let run = |(phi_on, dp_on): (bool, bool)| {
             let mut sim = Simulator::new(&m, start, settings).unwrap();
             let mut phi = Variational::new(1e-10);
+            let mut by_r = ParameterSensitivity::new(&dp, 1e-10);
             let mut met = 0;
             while met < bounces {
                 let step = sim.step(f64::INFINITY).unwrap();
                 met += step.collision.is_some() as usize;
-                if follow {
+                if phi_on {
                     phi.follow(&sim, &step).unwrap();
                 }
+                if dp_on {
+                    by_r.follow(&sim, &step).unwrap();
+                }
             }
-            (*sim.state(), *phi.matrix())
+            (*sim.state(), *phi.matrix(), by_r.value())
         };
+        let plain = run((false, false)).0;
         assert_eq!(
-            run(false).0,
-            run(true).0,
+            plain,
+            run((true, false)).0,
             "following Φ leaves the run alone"
         );
+        assert_eq!(plain, run((false, true)).0, "following ∂x/∂r too");
         let mut g = c.benchmark_group(format!("variational/ball_bounce_{bounces}_bounces/{name}"));
         g.sample_size(10);
-        g.bench_function("run", |b| b.iter(|| run(black_box(false))));
-        g.bench_function("run_and_phi", |b| b.iter(|| run(black_box(true))));
+        g.bench_function("run", |b| b.iter(|| run(black_box((false, false)))));
+        g.bench_function("run_and_phi", |b| b.iter(|| run(black_box((true, false)))));
+        g.bench_function("run_and_d_by_r", |b| {
+            b.iter(|| run(black_box((false, true))))
+        });
         g.finish();
     }
 }

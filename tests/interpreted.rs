@@ -114,6 +114,16 @@ fn same_functions<M: Surfaces<N>, I: Surfaces<N>, const N: usize>(
     if let (Some(tc), Some(ti)) = (tc, ti) {
         agree(&format!("{name} q̈ tangent"), &tc.1, &ti.1);
     }
+    // By the parameters, along (1, 2, …).
+    let dp: Vec<f64> = (1..=c.parameter_names().len()).map(|k| k as f64).collect();
+    let (pc, pi) = (
+        c.accelerations_parameter_tangent(q, v, &dp),
+        i.accelerations_parameter_tangent(q, v, &dp),
+    );
+    assert_eq!(pc.is_some(), pi.is_some(), "{name}: ∂q̈/∂p in one only");
+    if let (Some(pc), Some(pi)) = (pc, pi) {
+        agree(&format!("{name} ∂q̈/∂p"), &pc.1, &pi.1);
+    }
     agree(
         &format!("{name} initial q"),
         &c.initial_coordinates(),
@@ -175,6 +185,20 @@ fn same_functions<M: Surfaces<N>, I: Surfaces<N>, const N: usize>(
         if let (Some(tc), Some(ti)) = (tc, ti) {
             agree(&format!("{w} collide tangent"), &tc.1, &ti.1);
         }
+        let (pc, pi) = (
+            c.collide_parameter_tangent(wc, q, v, &dp),
+            i.collide_parameter_tangent(wi, q, v, &dp),
+        );
+        assert_eq!(pc.is_some(), pi.is_some(), "{w}: ∂v⁺/∂p in one only");
+        if let (Some(pc), Some(pi)) = (pc, pi) {
+            agree(&format!("{w} ∂v⁺/∂p"), &pc.1, &pi.1);
+        }
+        let (fc, fi) = (
+            c.surface_parameter_tangent(wc, q, &dp),
+            i.surface_parameter_tangent(wi, q, &dp),
+        );
+        assert!(fc.is_some() && fi.is_some(), "{w}: ∂f/∂p in both");
+        agree(&format!("{w} ∂f/∂p"), &[fc.unwrap().1], &[fi.unwrap().1]);
         agree(&format!("{w} normal"), &c.normal(wc, q), &i.normal(wi, q));
         let (nc, ni) = (c.normal_velocity(wc, q, v), i.normal_velocity(wi, q, v));
         agree(&format!("{w} normal velocity"), &[nc], &[ni]);

@@ -8,7 +8,7 @@ use dalembert::for_each_model;
 use dalembert::models::*;
 use dalembert::runtime::linalg::projector;
 use dalembert::runtime::prelude::*;
-use dalembert::runtime::simulate::{Settings, Simulator, State, Variational};
+use dalembert::runtime::simulate::{ParameterSensitivity, Settings, Simulator, State, Variational};
 
 struct Counting;
 
@@ -40,8 +40,9 @@ fn allocations_during(f: impl FnOnce()) -> usize {
 }
 
 /// A simulation of `m` from `start` to `t_end`, with Φ = ∂x/∂x₀ followed
-/// ([`Variational`]): the collisions met and the heap allocations made,
-/// from the simulator's construction on.
+/// ([`Variational`]) and the derivative by the parameters along
+/// (1, 1, …) ([`ParameterSensitivity`]): the collisions met and the heap
+/// allocations made, from the simulator's construction on.
 fn simulated<M: Surfaces<N>, const N: usize>(
     m: &M,
     start: State<N>,
@@ -49,14 +50,18 @@ fn simulated<M: Surfaces<N>, const N: usize>(
     t_end: f64,
 ) -> (u64, usize) {
     let mut collisions = 0;
+    let dp = [1.0; 16];
+    let dp = &dp[..m.parameter_names().len()];
     let n = allocations_during(|| {
         let mut sim = Simulator::new(m, start, settings).unwrap();
         let mut phi = Variational::new(1e-10);
+        let mut by_p = ParameterSensitivity::new(dp, 1e-10);
         while sim.state().t < t_end {
             let step = sim.step(t_end).unwrap();
             collisions += u64::from(step.collision.is_some());
             // Φ carried along, through the collisions.
             phi.follow(&sim, &step).unwrap();
+            by_p.follow(&sim, &step).unwrap();
             // The motion inside the step, off its dense output, too.
             let inside = sim.state_at(0.5 * (step.t0 + step.state.t));
             std::hint::black_box(inside.unwrap());

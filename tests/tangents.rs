@@ -4,9 +4,12 @@
 //! Richardson extrapolation, on every generated model at random parameters
 //! and states, and on the interpreted models of `tests/walls/` (walls
 //! through square roots, quotients, logarithms, sines, tangents and
-//! exponentials; a sleigh's constraint; a pendulum's holonomic constraint).
+//! exponentials; sleighs' constraints, one with a blade offset and a rink
+//! that move with the parameters; a pendulum's holonomic constraint).
 //! And an exact identity: the map is linear in admissible v⁻, so its
-//! derivative along an admissible δv⁻ is (I − 2P)δv⁻.
+//! derivative along an admissible δv⁻ is (I − 2P)δv⁻. The derivatives by
+//! the parameters (of q̈, of each map and each wall's f) the same way,
+//! with the parameters moved along a random direction.
 
 mod common;
 
@@ -247,6 +250,99 @@ fn against_numeric_solves<M: Surfaces<N>, const N: usize>(
     Ok(())
 }
 
+/// A random direction of the parameters, from the state's bits.
+fn parameter_direction(count: usize, seed: u64) -> Vec<f64> {
+    let mut state = seed | 1;
+    (0..count)
+        .map(|_| 2.0 * common::lcg(&mut state) - 1.0)
+        .collect()
+}
+
+/// `m` with its parameters moved by `s·dp`.
+fn moved_parameters<M: Model<Q, N> + Clone, const Q: usize, const N: usize>(
+    m: &M,
+    dp: &[f64],
+    s: f64,
+) -> M {
+    let mut moved = m.clone();
+    for (k, d) in dp.iter().enumerate() {
+        let x = m.parameter(k).expect("a parameter for each entry");
+        moved.set_parameter(k, x + s * d);
+    }
+    moved
+}
+
+/// The derivatives by the parameters (q̈'s, each wall's map and f) along a
+/// random direction against differences of the functions with the
+/// parameters moved, the state held; the tangents' values are the
+/// functions'. A direction of the wrong length has none.
+fn parameters_by_differences<M: Surfaces<N> + Clone, const N: usize>(
+    m: &M,
+    q: &[f64; N],
+    v: [f64; N],
+) -> Result<(), TestCaseError> {
+    let v = onto_kernel(&m.constraints(q), v);
+    let count = m.parameter_names().len();
+    let dp = parameter_direction(count, q[0].to_bits() ^ v[0].to_bits());
+    let wrong = vec![1.0; count + 1];
+    let fd = |f: &dyn Fn(&M) -> Vec<f64>| differences(|s| f(&moved_parameters(m, &dp, s)), 1e-3);
+    if let Some(a) = m.closed_form_accelerations(q, &v) {
+        let (value, da) = m
+            .accelerations_parameter_tangent(q, &v, &dp)
+            .expect("a model that writes q̈ out has its derivative by the parameters");
+        assert_eq!(value, a, "{}: the tangent's q̈ is q̈", m.name());
+        assert!(m.accelerations_parameter_tangent(q, &v, &wrong).is_none());
+        if a.iter().all(|x| x.is_finite()) {
+            let fd = fd(&|m: &M| m.closed_form_accelerations(q, &v).unwrap().to_vec());
+            agree(&format!("{} ∂q̈/∂p δp", m.name()), &da, &fd, &a).map_err(TestCaseError::fail)?;
+        }
+    }
+    for &wall in m.walls() {
+        let name = format!("{} {}", m.name(), m.wall_name(wall));
+        let (f, df) = m
+            .surface_parameter_tangent(wall, q, &dp)
+            .expect("every generated wall has f's derivative by the parameters");
+        assert_eq!(f, m.surface(wall, q), "{name}: the tangent's f is f");
+        assert!(m.surface_parameter_tangent(wall, q, &wrong).is_none());
+        let fd_f = fd(&|m: &M| vec![m.surface(wall, q)]);
+        agree(&format!("{name} ∂f/∂p δp"), &[df], &fd_f, &[f]).map_err(TestCaseError::fail)?;
+    }
+    collisions_by_parameters(m, q, v)
+}
+
+/// Each wall's ∂v⁺/∂p along a random direction of the parameters against
+/// differences of the map with the parameters moved, at an admissible v⁻.
+fn collisions_by_parameters<M: Walls<Q, N> + Clone, const Q: usize, const N: usize>(
+    m: &M,
+    q: &[f64; Q],
+    v: [f64; N],
+) -> Result<(), TestCaseError> {
+    let v = onto_kernel(&m.constraints(q), v);
+    let count = m.parameter_names().len();
+    let dp = parameter_direction(count, v[0].to_bits());
+    for &wall in m.walls() {
+        let name = format!("{} {}", m.name(), m.wall_name(wall));
+        let Some((after, dafter)) = m.collide_parameter_tangent(wall, q, &v, &dp) else {
+            assert!(m.collide_tangent(wall, q, &v, q, &v).is_none(), "{name}");
+            continue;
+        };
+        assert_eq!(
+            after,
+            m.collide(wall, q, &v),
+            "{name}: the tangent's v⁺ is v⁺"
+        );
+        if after.iter().all(|x| x.is_finite()) {
+            let fd = differences(
+                |s| moved_parameters(m, &dp, s).collide(wall, q, &v).to_vec(),
+                1e-3,
+            );
+            agree(&format!("{name} ∂v⁺/∂p δp"), &dafter, &fd, &after)
+                .map_err(TestCaseError::fail)?;
+        }
+    }
+    Ok(())
+}
+
 /// The walls of a generated model whose collision map has no tangent.
 fn tangent_walls<M: Walls<Q, N> + FromParams, const Q: usize, const N: usize>() -> Vec<String> {
     let m = M::with_params(Default::default());
@@ -263,6 +359,7 @@ macro_rules! tangent_test {
         #[test]
         fn $module() {
             for_random_cases::<$ty, 0, $n>(64, collisions);
+            for_random_cases::<$ty, 0, $n>(64, collisions_by_parameters);
         }
     };
     ($module:ident, $ty:ident, $q:literal, $n:literal) => {
@@ -271,6 +368,7 @@ macro_rules! tangent_test {
             for_random_cases::<$ty, $q, $n>(64, collisions);
             for_random_cases::<$ty, $n, $n>(64, accelerations_by_differences);
             for_random_cases::<$ty, $n, $n>(64, against_numeric_solves);
+            for_random_cases::<$ty, $n, $n>(64, parameters_by_differences);
         }
     };
 }
@@ -311,7 +409,8 @@ fn interpreted_models_with_nonpolynomial_walls() {
     ) -> Result<(), TestCaseError> {
         collisions(m, q, v)?;
         accelerations_by_differences(m, q, v)?;
-        against_numeric_solves(m, q, v)
+        against_numeric_solves(m, q, v)?;
+        parameters_by_differences(m, q, v)
     }
     fn run<const N: usize>(name: &str) {
         let m = interpreted::<N>(name);
@@ -344,4 +443,5 @@ fn interpreted_models_with_nonpolynomial_walls() {
         run::<2>(name);
     }
     run::<3>("sleigh_rink");
+    run::<3>("sleigh_oval");
 }

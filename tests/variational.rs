@@ -19,14 +19,11 @@ mod common;
 use std::path::Path;
 
 use dalembert::models::{BallBounce, PendulumWall};
-use dalembert::runtime::linalg::correction;
 use dalembert::runtime::prelude::*;
-use dalembert::runtime::simulate::{
-    DormandPrince, Integrator, Rk4, Settings, Simulator, State, Taylor, Variational,
-};
+use dalembert::runtime::simulate::{Settings, Simulator, State, Variational};
 use dalembert_codegen::interpret::Interpreted;
 
-use common::{admissible_direction, lcg};
+use common::{admissible_direction, integrators, lcg, onto_manifold};
 
 fn interpreted<const N: usize>(name: &str, g: f64) -> Interpreted<N> {
     let file = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -36,66 +33,6 @@ fn interpreted<const N: usize>(name: &str, g: f64) -> Interpreted<N> {
     let mut m = Interpreted::new(&d).unwrap_or_else(|e| panic!("{name}: {e}"));
     assert!(m.set_parameter_named("g", g));
     m
-}
-
-/// Each integrator with the step of the differences and the agreement
-/// required. A fixed-step RK4 run's end moves with the start by more than
-/// rounding (its last steps before each collision and before t_end are cut
-/// where the collision falls): on the spinning ball the discrepancy grew as
-/// 1/ε (1.8e-6 at ε = 1e-4, 8e-6 at 1e-5, 3.8e-5 at 1e-6) and did not move
-/// when RK4's step was halved, so its differences take a larger ε.
-fn integrators() -> [(&'static str, Settings, f64, f64); 3] {
-    let with = |integrator| Settings {
-        integrator,
-        ..Settings::default()
-    };
-    [
-        (
-            "Dormand–Prince",
-            with(Integrator::DormandPrince(DormandPrince {
-                rtol: 1e-12,
-                atol: 1e-14,
-                max_step: f64::INFINITY,
-            })),
-            1e-5,
-            1e-6,
-        ),
-        (
-            "Taylor",
-            with(Integrator::Taylor(Taylor {
-                tolerance: 1e-15,
-                ..Taylor::default()
-            })),
-            1e-5,
-            1e-6,
-        ),
-        ("RK4", with(Integrator::Rk4(Rk4 { step: 2e-4 })), 1e-4, 1e-5),
-    ]
-}
-
-/// (q, v) moved onto h(q) = 0 (Gauss–Newton) and v onto ker A(q).
-fn onto_manifold<M: Dynamics<N>, const N: usize>(
-    m: &M,
-    q: [f64; N],
-    v: [f64; N],
-) -> ([f64; N], [f64; N]) {
-    let mut q = q;
-    let identity: [[f64; N]; N] =
-        std::array::from_fn(|i| std::array::from_fn(|j| (i == j) as u8 as f64));
-    for _ in 0..5 {
-        let h = m.holonomic(&q);
-        if h.as_slice().is_empty() {
-            break;
-        }
-        let a = m.constraints(&q);
-        let rows = &a.as_slice()[..h.as_slice().len()];
-        let d = correction(&identity, rows, h.as_slice()).unwrap();
-        q = std::array::from_fn(|i| q[i] - d[i]);
-    }
-    (
-        q,
-        dalembert::runtime::simulate::admissible(m, &q, &v).unwrap(),
-    )
 }
 
 /// The state at `t_end` from (q, v), the collisions on the way, and Φ
@@ -181,12 +118,7 @@ fn check<M: Surfaces<N>, const N: usize>(m: &M, x0: ([f64; N], [f64; N]), t_end:
             };
             let fd = common::richardson(at, 2.0 * eps);
             let got: Vec<f64> = pq.iter().chain(&pv).copied().collect();
-            let scale = fd.iter().fold(1.0_f64, |a, x| a.max(x.abs()));
-            let worst = got
-                .iter()
-                .zip(&fd)
-                .fold(0.0_f64, |a, (g, f)| a.max((g - f).abs()))
-                / scale;
+            let (worst, scale) = common::relative_gap(&got, &fd);
             eprintln!(
                 "{} ({method}), direction {k}: |Φ δx₀ − differences| / |differences| = {worst:.1e} ({collisions} collisions)",
                 m.name()

@@ -45,6 +45,14 @@ pub enum Quantity {
     AccelerationsTangent,
     /// A wall's (I − 2P)v and its derivative along a direction (δq, δv).
     CollideTangent,
+    /// q̈ and its derivative along a direction δp of the parameters.
+    AccelerationsParameterTangent,
+    /// A wall's (I − 2P)v and its derivative along a direction δp of the
+    /// parameters.
+    CollideParameterTangent,
+    /// A wall's f(q) and its derivative along a direction δp of the
+    /// parameters.
+    SurfaceParameterTangent,
     /// The starting state of the file's `[initial]`, at the parameters in
     /// use.
     InitialState,
@@ -61,6 +69,90 @@ pub enum Inputs {
     Phase,
     /// The coordinates q, the velocities v, and a direction (δq, δv).
     Tangent,
+    /// The coordinates q and a direction δp of the parameters.
+    CoordinatesByParameters,
+    /// The coordinates q, the velocities v, and a direction δp of the
+    /// parameters.
+    PhaseByParameters,
+}
+
+/// One array an emitted function takes besides the parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Array {
+    /// The coordinates q (Q numbers).
+    Q,
+    /// The velocities v (N numbers).
+    V,
+    /// A direction δq of the coordinates (Q numbers).
+    Dq,
+    /// A direction δv of the velocities (N numbers).
+    Dv,
+    /// A direction δp of the parameters (one number each).
+    Dp,
+}
+
+impl Array {
+    /// Its argument's name in emitted code.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Q => "q",
+            Self::V => "v",
+            Self::Dq => "dq",
+            Self::Dv => "dv",
+            Self::Dp => "dp",
+        }
+    }
+
+    /// How many numbers it holds, in a model with `params` parameters,
+    /// `q` coordinates and `n` velocities.
+    pub fn len(self, params: usize, q: usize, n: usize) -> usize {
+        match self {
+            Self::Q | Self::Dq => q,
+            Self::V | Self::Dv => n,
+            Self::Dp => params,
+        }
+    }
+}
+
+impl Inputs {
+    /// The arrays it takes, in the order the program's inputs follow the
+    /// parameters: the one layout the emitted arguments, the trait
+    /// methods and the interpreter read.
+    pub fn arrays(self) -> &'static [Array] {
+        match self {
+            Self::Parameters => &[],
+            Self::Coordinates => &[Array::Q],
+            Self::Phase => &[Array::Q, Array::V],
+            Self::Tangent => &[Array::Q, Array::V, Array::Dq, Array::Dv],
+            Self::CoordinatesByParameters => &[Array::Q, Array::Dp],
+            Self::PhaseByParameters => &[Array::Q, Array::V, Array::Dp],
+        }
+    }
+
+    /// How many inputs a program of this quantity reads: the parameters
+    /// and its arrays.
+    pub fn width(self, params: usize, q: usize, n: usize) -> usize {
+        params
+            + self
+                .arrays()
+                .iter()
+                .map(|a| a.len(params, q, n))
+                .sum::<usize>()
+    }
+
+    /// The array holding input `i` of a program (after the `params`
+    /// parameters), and the index in it; `None` for a parameter.
+    pub fn array_of(self, i: usize, params: usize, q: usize, n: usize) -> Option<(Array, usize)> {
+        let mut at = i.checked_sub(params)?;
+        for &a in self.arrays() {
+            let len = a.len(params, q, n);
+            if at < len {
+                return Some((a, at));
+            }
+            at -= len;
+        }
+        None
+    }
 }
 
 /// What an emitted function returns.
@@ -81,6 +173,8 @@ pub enum Shape {
     /// N numbers and their derivatives along a direction: the program's
     /// outputs are the values, then the derivatives (each padded to N).
     Tangent,
+    /// One number and its derivative along a direction.
+    ScalarTangent,
 }
 
 /// How the `Model` trait method returns the inherent function's value.
@@ -233,6 +327,15 @@ pub const TABLE: &[Spec] = &[
         method: Some(("accelerations_tangent", Forward::Some)),
     },
     Spec {
+        quantity: Quantity::AccelerationsParameterTangent,
+        name: "accelerations_parameter_tangent",
+        inputs: Inputs::PhaseByParameters,
+        shape: Shape::Tangent,
+        doc: "q̈ as `accelerations` computes it, and its derivative along a direction δp of the parameters (in `PARAMETERS` order) at fixed (q, v): (q̈, ∂q̈/∂p δp), by forward differentiation of the same program.",
+        capability: Capability::Dynamics,
+        method: Some(("accelerations_parameter_tangent", Forward::Some)),
+    },
+    Spec {
         quantity: Quantity::InitialState,
         name: "initial_state",
         inputs: Inputs::Parameters,
@@ -312,6 +415,24 @@ pub const TABLE: &[Spec] = &[
         doc: "Wall `{wall}`: v⁺ as `collide` computes it, and its derivative along (δq, δv⁻): (v⁺, ∂v⁺/∂q δq + ∂v⁺/∂v⁻ δv⁻), by forward differentiation of the same program.",
         capability: Capability::Walls,
         method: Some(("collide_tangent", Forward::Some)),
+    },
+    Spec {
+        quantity: Quantity::CollideParameterTangent,
+        name: "collide_parameter_tangent",
+        inputs: Inputs::PhaseByParameters,
+        shape: Shape::Tangent,
+        doc: "Wall `{wall}`: v⁺ as `collide` computes it, and its derivative along a direction δp of the parameters (in `PARAMETERS` order) at fixed (q, v⁻): (v⁺, ∂v⁺/∂p δp), by forward differentiation of the same program.",
+        capability: Capability::Walls,
+        method: Some(("collide_parameter_tangent", Forward::Some)),
+    },
+    Spec {
+        quantity: Quantity::SurfaceParameterTangent,
+        name: "surface_parameter_tangent",
+        inputs: Inputs::CoordinatesByParameters,
+        shape: Shape::ScalarTangent,
+        doc: "Wall `{wall}`: f(q) as `surface` computes it, and its derivative along a direction δp of the parameters (in `PARAMETERS` order) at fixed q: (f, ∂f/∂p δp).",
+        capability: Capability::Surfaces,
+        method: Some(("surface_parameter_tangent", Forward::Some)),
     },
 ];
 

@@ -123,6 +123,24 @@ pub trait Walls<const Q: usize, const N: usize>: Model<Q, N> {
         None
     }
 
+    /// The collision map and its derivative along a direction δp of the
+    /// parameters (one entry each, in [`Model::parameter_names`] order) at
+    /// fixed (q, v⁻): (v⁺, ∂v⁺/∂p δp), for admissible v⁻ as in
+    /// [`Walls::collide`]. Generated models differentiate the map's own
+    /// program, as [`Walls::collide_tangent`]; `None` (the default, a wall
+    /// whose P is solved at run time, and a `dp` whose length is not the
+    /// number of parameters) means no derivative.
+    fn collide_parameter_tangent(
+        &self,
+        wall: Self::Wall,
+        q: &[f64; Q],
+        v: &[f64; N],
+        dp: &[f64],
+    ) -> Option<([f64; N], [f64; N])> {
+        let _ = (wall, q, v, dp);
+        None
+    }
+
     /// The Jacobian of the collision map at (q, v⁻): (∂v⁺/∂q, ∂v⁺/∂v⁻),
     /// entry `[i][j]` the derivative of v⁺ᵢ by qⱼ (resp. v⁻ⱼ), from Q + N
     /// calls of [`Walls::collide_tangent`]; `None` where that is.
@@ -212,6 +230,23 @@ pub trait Dynamics<const N: usize>: Model<N, N> {
         None
     }
 
+    /// [`Dynamics::closed_form_accelerations`] and its derivative along a
+    /// direction δp of the parameters (one entry each, in
+    /// [`Model::parameter_names`] order) at fixed (q, v): (q̈, ∂q̈/∂p δp),
+    /// by forward differentiation of q̈'s program as
+    /// [`Dynamics::accelerations_tangent`]. `None` (the default) where the
+    /// model writes no q̈ out, and for a `dp` whose length is not the
+    /// number of parameters.
+    fn accelerations_parameter_tangent(
+        &self,
+        q: &[f64; N],
+        v: &[f64; N],
+        dp: &[f64],
+    ) -> Option<([f64; N], [f64; N])> {
+        let _ = (q, v, dp);
+        None
+    }
+
     /// The Jacobian of q̈ at (q, v): (∂q̈/∂q, ∂q̈/∂v), entry `[i][j]` the
     /// derivative of q̈ᵢ by qⱼ (resp. vⱼ), from 2N calls of
     /// [`Dynamics::accelerations_tangent`]; `None` where that is. The
@@ -284,6 +319,21 @@ pub trait Surfaces<const N: usize>: Dynamics<N> + Walls<N, N> {
     /// the default `None` (unknown) means steps are not aimed at this wall.
     fn surface_hessian(&self, wall: Self::Wall, q: &[f64; N], v: &[f64; N]) -> Option<f64> {
         let _ = (wall, q, v);
+        None
+    }
+
+    /// The wall's f(q) and its derivative along a direction δp of the
+    /// parameters (one entry each, in [`Model::parameter_names`] order) at
+    /// fixed q: (f, ∂f/∂p δp); how a collision instant moves with the
+    /// parameters. Generated models emit it; `None` (the default, and a
+    /// `dp` whose length is not the number of parameters): unknown.
+    fn surface_parameter_tangent(
+        &self,
+        wall: Self::Wall,
+        q: &[f64; N],
+        dp: &[f64],
+    ) -> Option<(f64, f64)> {
+        let _ = (wall, q, dp);
         None
     }
 

@@ -74,6 +74,19 @@ impl<const N: usize> StateMatrix<N> {
     }
 }
 
+/// What a direction δp of the parameters adds at a collision: with the
+/// state x(t₀) held fixed, the derivative of the run along δp jumps as
+/// δx⁺ = S δx⁻ + `dx`, and the collision instant moves by
+/// `dt_dq · δq⁻ + dt`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParameterJump<const N: usize> {
+    /// The jump's part from δp over (q, v): (0, ∂v⁺/∂p δp) for the map's
+    /// own change, plus (F⁺ − R F⁻) (∂f/∂p δp)/(df·v⁻) for the instant's.
+    pub dx: ([f64; N], [f64; N]),
+    /// The instant's shift from δp: −(∂f/∂p δp)/(df·v⁻).
+    pub dt: f64,
+}
+
 /// A collision's saltation matrix and the sensitivity of its instant.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Saltation<const N: usize> {
@@ -96,7 +109,9 @@ pub enum SaltationError {
         normal_velocity: f64,
     },
     /// The model has no derivative of this wall's collision map
-    /// ([`Walls::collide_tangent`] is `None`).
+    /// ([`Walls::collide_tangent`] is `None`), or, for a direction of the
+    /// parameters ([`parameter_jump`]), none of the map or of the wall's f
+    /// along it.
     NoDerivative,
     /// q̈ before or after the collision could not be computed.
     Dynamics(DynamicsError),
@@ -123,15 +138,7 @@ pub fn saltation<M: Surfaces<N>, const N: usize>(
     q: &[f64; N],
     v_minus: &[f64; N],
 ) -> Result<Saltation<N>, SaltationError> {
-    let df = m.normal(wall, q);
-    let sigma = linalg::dot(&df, v_minus);
-    let size2 = linalg::dot(&df, &df) * linalg::dot(v_minus, v_minus);
-    let clear = sigma * sigma > 1e-18 * size2; // false for NaN too
-    if !clear {
-        return Err(SaltationError::Grazing {
-            normal_velocity: sigma,
-        });
-    }
+    let (df, sigma) = crossing(m, wall, q, v_minus)?;
     let (cq, cv) = m
         .collide_jacobian(wall, q, v_minus)
         .ok_or(SaltationError::NoDerivative)?;
@@ -159,4 +166,61 @@ pub fn saltation<M: Surfaces<N>, const N: usize>(
         dt_dq: core::array::from_fn(|j| -df[j] / sigma),
         v_plus,
     })
+}
+
+/// What a direction δp of the parameters (one entry each, in
+/// [`crate::Model::parameter_names`] order) adds at a collision with
+/// `wall` at (q, v⁻), the state before the collision held fixed. From
+/// f(q(t*), p) = 0, the instant moves by δt* = −(df·δq⁻ + ∂f/∂p δp)/σ,
+/// σ = df·v⁻, and the state after it at the unperturbed instant by
+/// S δx⁻ + (0, ∂v⁺/∂p δp) + (F⁺ − R F⁻)(∂f/∂p δp)/σ; R F⁻ is one tangent
+/// of the map, along F⁻ = (v⁻, q̈⁻). Errors as [`saltation`]'s.
+pub fn parameter_jump<M: Surfaces<N>, const N: usize>(
+    m: &M,
+    wall: <M as Walls<N, N>>::Wall,
+    q: &[f64; N],
+    v_minus: &[f64; N],
+    dp: &[f64],
+) -> Result<ParameterJump<N>, SaltationError> {
+    let (_, sigma) = crossing(m, wall, q, v_minus)?;
+    let (_, f_p) = m
+        .surface_parameter_tangent(wall, q, dp)
+        .ok_or(SaltationError::NoDerivative)?;
+    let (v_plus, by_p) = m
+        .collide_parameter_tangent(wall, q, v_minus, dp)
+        .ok_or(SaltationError::NoDerivative)?;
+    let a_minus = qdd(m, q, v_minus).map_err(SaltationError::Dynamics)?;
+    let a_plus = qdd(m, q, &v_plus).map_err(SaltationError::Dynamics)?;
+    let (_, r_f) = m
+        .collide_tangent(wall, q, v_minus, v_minus, &a_minus)
+        .ok_or(SaltationError::NoDerivative)?;
+    let shift = f_p / sigma;
+    Ok(ParameterJump {
+        dx: (
+            core::array::from_fn(|i| (v_plus[i] - v_minus[i]) * shift),
+            core::array::from_fn(|i| by_p[i] + (a_plus[i] - r_f[i]) * shift),
+        ),
+        dt: -shift,
+    })
+}
+
+/// The wall's normal df(q) and the normal velocity σ = df·v⁻, or the
+/// grazing error where |σ| is at most 1e-9 of |df| |v⁻| (or not finite).
+fn crossing<M: Surfaces<N>, const N: usize>(
+    m: &M,
+    wall: <M as Walls<N, N>>::Wall,
+    q: &[f64; N],
+    v_minus: &[f64; N],
+) -> Result<([f64; N], f64), SaltationError> {
+    let df = m.normal(wall, q);
+    let sigma = linalg::dot(&df, v_minus);
+    let size2 = linalg::dot(&df, &df) * linalg::dot(v_minus, v_minus);
+    let clear = sigma * sigma > 1e-18 * size2; // false for NaN too
+    if clear {
+        Ok((df, sigma))
+    } else {
+        Err(SaltationError::Grazing {
+            normal_velocity: sigma,
+        })
+    }
 }

@@ -158,7 +158,12 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
     functions.push(initial_state(&sym, &compile, cx)?);
     let mut functions = functions.into_iter().flatten().collect();
     let mut walls = walls;
-    let tangents_left_out = tangents(&mut functions, &mut walls, sym.params.len());
+    let dims = (
+        sym.params.len(),
+        model.coordinates.len(),
+        model.velocities.len(),
+    );
+    let tangents_left_out = tangents(&mut functions, &mut walls, dims);
     Ok(Derivation {
         model: model.clone(),
         mass_matrix: strings(&exact.g),
@@ -172,56 +177,88 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
     })
 }
 
-/// Pass 6: the tangent functions, q̈'s and each collision map's program
-/// differentiated forward along the phase (the inputs after the
-/// `params` parameters), each placed after the function it differentiates.
-/// They are about three times the code of what they differentiate: where
-/// they would take the model past [`crate::MAX_GENERATED_INSTRUCTIONS`]
-/// they are left out (the model then has no derivatives, and its header
-/// says why; a model past the bound without them is refused as before),
-/// and the number of instructions they would have added is returned.
+/// Pass 6: the tangent functions, each placed after the function it
+/// differentiates: q̈'s and each collision map's program differentiated
+/// forward along the phase (the inputs after the `params` parameters) and
+/// along the parameters, and each wall's f along the parameters (what a
+/// collision instant's dependence on them needs). They are about three
+/// times the code of what they differentiate: where they would take the
+/// model past [`crate::MAX_GENERATED_INSTRUCTIONS`] they are left out (the
+/// model then has no derivatives, and its header says why; a model past
+/// the bound without them is refused as before), and the number of
+/// instructions they would have added is returned.
 fn tangents(
     functions: &mut Vec<Function>,
     walls: &mut [WallDerivation],
-    params: usize,
+    (params, nq, nv): (usize, usize, usize),
 ) -> Option<usize> {
-    let tangent = |list: &[Function], of: Quantity, quantity: Quantity| {
-        let i = list.iter().position(|f| f.quantity == of)?;
-        let program = list[i].program.tangent(params);
-        Some((
-            i + 1,
-            Function {
-                quantity,
-                program,
-                rows: 0,
-            },
-        ))
+    // (differentiated, tangent, along the parameters rather than the phase)
+    const MODEL: &[(Quantity, Quantity, bool)] = &[
+        (
+            Quantity::Accelerations,
+            Quantity::AccelerationsTangent,
+            false,
+        ),
+        (
+            Quantity::Accelerations,
+            Quantity::AccelerationsParameterTangent,
+            true,
+        ),
+    ];
+    const WALL: &[(Quantity, Quantity, bool)] = &[
+        (Quantity::Collide, Quantity::CollideTangent, false),
+        (Quantity::Collide, Quantity::CollideParameterTangent, true),
+        (Quantity::Surface, Quantity::SurfaceParameterTangent, true),
+    ];
+    let tangents = |list: &[Function], rows: &[(Quantity, Quantity, bool)]| -> Vec<Function> {
+        rows.iter()
+            .filter_map(|&(of, quantity, by_parameters)| {
+                let f = list.iter().find(|f| f.quantity == of)?;
+                let source = (f.program).with_inputs(of.spec().inputs.width(params, nq, nv));
+                let program = if by_parameters {
+                    source.tangent_over(0..params)
+                } else {
+                    source.tangent(params)
+                };
+                Some(Function {
+                    quantity,
+                    program,
+                    rows: 0,
+                })
+            })
+            .collect()
     };
-    let model = tangent(
-        functions,
-        Quantity::Accelerations,
-        Quantity::AccelerationsTangent,
-    );
-    let per_wall: Vec<_> = (walls.iter())
-        .map(|w| tangent(&w.functions, Quantity::Collide, Quantity::CollideTangent))
-        .collect();
+    let model = tangents(functions, MODEL);
+    let per_wall: Vec<_> = walls.iter().map(|w| tangents(&w.functions, WALL)).collect();
     let size = |fs: &[Function]| fs.iter().map(|f| f.program.instrs.len()).sum::<usize>();
     let now = size(functions) + walls.iter().map(|w| size(&w.functions)).sum::<usize>();
-    let added: usize = (model.iter().chain(per_wall.iter().flatten()))
-        .map(|(_, f)| f.program.instrs.len())
-        .sum();
+    let added = size(&model) + per_wall.iter().map(|fs| size(fs)).sum::<usize>();
     if now + added > crate::MAX_GENERATED_INSTRUCTIONS {
         return Some(added);
     }
-    if let Some((i, f)) = model {
-        functions.insert(i, f);
-    }
-    for (w, t) in walls.iter_mut().zip(per_wall) {
-        if let Some((i, f)) = t {
-            w.functions.insert(i, f);
-        }
+    insert_after_sources(functions, model, MODEL);
+    for (w, fs) in walls.iter_mut().zip(per_wall) {
+        insert_after_sources(&mut w.functions, fs, WALL);
     }
     None
+}
+
+/// Each tangent placed after the function it differentiates (and after
+/// that function's tangents placed before it).
+fn insert_after_sources(
+    list: &mut Vec<Function>,
+    tangents: Vec<Function>,
+    rows: &[(Quantity, Quantity, bool)],
+) {
+    for t in tangents {
+        let of = rows.iter().find(|r| r.1 == t.quantity).map(|r| r.0);
+        let source = list.iter().position(|f| Some(f.quantity) == of);
+        let after = source.map_or(list.len(), |i| {
+            let tangents_of = |f: &Function| rows.iter().any(|r| r.1 == f.quantity);
+            i + 1 + list[i + 1..].iter().take_while(|f| tangents_of(f)).count()
+        });
+        list.insert(after, t);
+    }
 }
 
 /// The `[initial]` state as a function of the parameters, so that it

@@ -15,6 +15,7 @@ use super::{Ctx, Scalar, ident};
 use crate::plan::Step;
 use crate::program::machine::{Machine, Operand};
 use crate::program::{Program, Slot};
+use crate::quantity::Inputs;
 
 /// `f64` or `f32` (or the runtime's `Interval`, formatting bounds).
 pub(super) fn real(d: &Ctx) -> TokenStream {
@@ -76,7 +77,13 @@ pub(super) enum Place {
 /// Statements computing `o0, o1, …` from the program, each instruction as
 /// its [`Step`] in `place` says: computed, stored as `pre[k]`, read from
 /// `self.pre[k]`, a kept value computed, or left out.
-pub(super) fn statements(d: &Ctx, p: &Program, steps: &[Step], place: Place) -> TokenStream {
+pub(super) fn statements(
+    d: &Ctx,
+    p: &Program,
+    steps: &[Step],
+    inputs: Inputs,
+    place: Place,
+) -> TokenStream {
     let mut used = vec![false; p.inputs];
     for m in steps.iter().filter_map(Step::machine) {
         for s in m.slots() {
@@ -92,7 +99,7 @@ pub(super) fn statements(d: &Ctx, p: &Program, steps: &[Step], place: Place) -> 
     };
     let inputs = used.iter().enumerate().filter(|(_, u)| **u).map(|(i, _)| {
         let name = format_ident!("i{i}");
-        let value = input_value(d, i, &params);
+        let value = input_value(d, i, inputs, &params);
         let value = if i < d.model.params.len() {
             number(d, value)
         } else {
@@ -244,25 +251,24 @@ fn expression(d: &Ctx, p: &Program, m: &Machine) -> TokenStream {
 
 /// Where input i of every program comes from: parameters, then coordinates,
 /// then velocities.
-fn input_value(d: &Ctx, i: usize, params: &TokenStream) -> TokenStream {
-    let np = d.model.params.len();
-    let nq = d.model.coordinates.len();
-    if i < np {
-        let p = ident(&d.model.params[i].name);
-        quote! { #params.#p }
-    } else if i < np + nq {
-        let k = Literal::usize_unsuffixed(i - np);
-        quote! { q[#k] }
-    } else {
-        // After the phase (q, v), a tangent function's direction (dq, dv).
-        let nv = d.model.velocities.len();
-        let (array, k) = match i - np - nq {
-            k if k < nv => ("v", k),
-            k if k < nv + nq => ("dq", k - nv),
-            k => ("dv", k - nv - nq),
-        };
-        let (array, k) = (format_ident!("{array}"), Literal::usize_unsuffixed(k));
-        quote! { #array[#k] }
+fn input_value(d: &Ctx, i: usize, inputs: Inputs, params: &TokenStream) -> TokenStream {
+    let (np, nq, nv) = (
+        d.model.params.len(),
+        d.model.coordinates.len(),
+        d.model.velocities.len(),
+    );
+    match inputs.array_of(i, np, nq, nv) {
+        None => {
+            let p = ident(&d.model.params[i].name);
+            quote! { #params.#p }
+        }
+        Some((array, k)) => {
+            let (array, k) = (
+                format_ident!("{}", array.name()),
+                Literal::usize_unsuffixed(k),
+            );
+            quote! { #array[#k] }
+        }
     }
 }
 

@@ -92,7 +92,8 @@ pub(super) fn inherent_impl(d: &Ctx) -> TokenStream {
 /// storing the values its per-call code reads.
 fn precompute(d: &Ctx) -> TokenStream {
     let blocks = d.plan.functions.iter().filter_map(|f| {
-        let stmts = body::statements(d, &f.function.program, &f.once, Place::Once);
+        let inputs = f.function.quantity.spec().inputs;
+        let stmts = body::statements(d, &f.function.program, &f.once, inputs, Place::Once);
         (f.split.stored > 0).then(|| quote! { { #stmts } })
     });
     let real = real(d);
@@ -214,6 +215,7 @@ fn emit_function(d: &Ctx, f: &Function, wall: Option<&str>) -> TokenStream {
                 quote! { ([#(#values),*], [#(#derivatives),*]) },
             )
         }
+        Shape::ScalarTangent => (quote! { (#real, #real) }, quote! { (o0, o1) }),
         Shape::State => {
             let ql = Literal::usize_unsuffixed(q);
             let q_outs = (0..q).map(|i| format_ident!("o{i}"));
@@ -275,21 +277,17 @@ pub(super) fn dims(d: &Ctx) -> (usize, usize) {
     (d.model.coordinates.len(), d.model.velocities.len())
 }
 
-/// Nothing, `q: &[f64; Q]`, `q: &[f64; Q], v: &[f64; N]`, or those and
-/// `dq: &[f64; Q], dv: &[f64; N]`.
+/// The arguments `inputs` lists (`Inputs::arrays`), each `name: &[T; len]`,
+/// after `&self`.
 fn args(d: &Ctx, inputs: Inputs) -> TokenStream {
     let (q, n) = dims(d);
-    let q = Literal::usize_unsuffixed(q);
-    let n = Literal::usize_unsuffixed(n);
     let real = real(d);
-    match inputs {
-        Inputs::Parameters => quote! {},
-        Inputs::Coordinates => quote! { , q: &[#real; #q] },
-        Inputs::Phase => quote! { , q: &[#real; #q], v: &[#real; #n] },
-        Inputs::Tangent => {
-            quote! { , q: &[#real; #q], v: &[#real; #n], dq: &[#real; #q], dv: &[#real; #n] }
-        }
-    }
+    let args = inputs.arrays().iter().map(|a| {
+        let name = format_ident!("{}", a.name());
+        let len = Literal::usize_unsuffixed(a.len(d.model.params.len(), q, n));
+        quote! { , #name: &[#real; #len] }
+    });
+    quote! { #( #args )* }
 }
 
 /// An emitted method: doc, `#[inline]`, the arguments, the program's
@@ -308,7 +306,7 @@ fn function(
 ) -> TokenStream {
     let f = ident(name);
     let args = args(d, inputs);
-    let body = body::statements(d, p, steps, Place::Call);
+    let body = body::statements(d, p, steps, inputs, Place::Call);
     let doc = doc_attr(doc);
     // Over intervals the `let`s have no type, and clippy then calls the
     // last one before its return needless.

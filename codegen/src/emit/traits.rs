@@ -10,7 +10,7 @@ use super::functions::dims;
 use super::{Ctx, ident};
 use crate::ir::{Kind, camel};
 use crate::program::Transform;
-use crate::quantity::{Capability, Forward, Inputs, Shape, Spec, TABLE};
+use crate::quantity::{Array, Capability, Forward, Shape, Spec, TABLE};
 use dalembert_runtime::taylor::Work;
 
 pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
@@ -170,15 +170,31 @@ fn forward(d: &Ctx, spec: &Spec, variants: &[Ident]) -> Option<TokenStream> {
     let (q, n) = dims(d);
     let (ql, nl) = (Literal::usize_unsuffixed(q), Literal::usize_unsuffixed(n));
     let method = format_ident!("{method}");
-    let (args, params) = match spec.inputs {
-        Inputs::Parameters => (quote! {}, quote! {}),
-        Inputs::Coordinates => (quote! { q }, quote! { q: &[f64; #ql] }),
-        Inputs::Phase => (quote! { q, v }, quote! { q: &[f64; #ql], v: &[f64; #nl] }),
-        Inputs::Tangent => (
-            quote! { q, v, dq, dv },
-            quote! { q: &[f64; #ql], v: &[f64; #nl], dq: &[f64; #ql], dv: &[f64; #nl] },
-        ),
-    };
+    // The trait takes a direction of the parameters as a slice (its
+    // length is the model's); a slice of another length has no derivative.
+    let np = d.model.params.len();
+    let arrays = spec.inputs.arrays();
+    let names = arrays.iter().map(|a| format_ident!("{}", a.name()));
+    let args = quote! { #( #names ),* };
+    let params = arrays.iter().map(|a| {
+        let name = format_ident!("{}", a.name());
+        match a {
+            Array::Dp => quote! { #name: &[f64] },
+            _ => {
+                let len = Literal::usize_unsuffixed(a.len(np, q, n));
+                quote! { #name: &[f64; #len] }
+            }
+        }
+    });
+    let params = quote! { #( #params ),* };
+    let convert = arrays.contains(&Array::Dp).then(|| {
+        let npl = Literal::usize_unsuffixed(np);
+        quote! {
+            let Ok(dp) = <&[f64; #npl]>::try_from(dp) else {
+                return None;
+            };
+        }
+    });
     let wrapped = |call: TokenStream| match wrap {
         Forward::Plain => call,
         Forward::Some => quote! { Some(#call) },
@@ -191,6 +207,7 @@ fn forward(d: &Ctx, spec: &Spec, variants: &[Ident]) -> Option<TokenStream> {
         Shape::Values => quote! { ::dalembert_runtime::Values<#nl> },
         Shape::State => quote! { ([f64; #ql], [f64; #nl]) },
         Shape::Tangent => quote! { ([f64; #nl], [f64; #nl]) },
+        Shape::ScalarTangent => quote! { (f64, f64) },
     };
     let ret = match wrap {
         Forward::Plain => ty,
@@ -218,6 +235,6 @@ fn forward(d: &Ctx, spec: &Spec, variants: &[Ident]) -> Option<TokenStream> {
     };
     Some(quote! {
         #[inline]
-        fn #method(&self, #params) -> #ret { #value }
+        fn #method(&self, #params) -> #ret { #convert #value }
     })
 }

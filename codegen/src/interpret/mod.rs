@@ -44,6 +44,8 @@ struct WallPrograms {
     collide: Option<Compiled>,
     /// The collision map's tangent program, where it has a program.
     collide_tangent: Option<Compiled>,
+    collide_parameter_tangent: Option<Compiled>,
+    surface_parameter_tangent: Option<Compiled>,
 }
 
 /// Which wall of an [`Interpreted`] model: its index in file order.
@@ -76,6 +78,7 @@ pub struct Interpreted<const N: usize> {
     drift: Compiled,
     accelerations: Option<Compiled>,
     accelerations_tangent: Option<Compiled>,
+    accelerations_parameter_tangent: Option<Compiled>,
     /// The Taylor series, where q̈ is written out.
     series: Option<SeriesPrograms>,
     walls: Vec<WallPrograms>,
@@ -203,6 +206,8 @@ impl<const N: usize> Interpreted<N> {
                 projector: find(&w.functions, Quantity::Projector),
                 collide: find(&w.functions, Quantity::Collide),
                 collide_tangent: find(&w.functions, Quantity::CollideTangent),
+                collide_parameter_tangent: find(&w.functions, Quantity::CollideParameterTangent),
+                surface_parameter_tangent: find(&w.functions, Quantity::SurfaceParameterTangent),
             });
         }
         let series =
@@ -224,6 +229,10 @@ impl<const N: usize> Interpreted<N> {
             drift: model_fn(Quantity::ConstraintDrift)?,
             accelerations: find(&d.functions, Quantity::Accelerations),
             accelerations_tangent: find(&d.functions, Quantity::AccelerationsTangent),
+            accelerations_parameter_tangent: find(
+                &d.functions,
+                Quantity::AccelerationsParameterTangent,
+            ),
             indices: (0..walls.len()).map(WallIndex).collect(),
             walls,
             values,
@@ -243,7 +252,8 @@ impl<const N: usize> Interpreted<N> {
         .into_iter()
         .chain(self.holonomic.as_mut())
         .chain(self.accelerations.as_mut())
-        .chain(self.accelerations_tangent.as_mut());
+        .chain(self.accelerations_tangent.as_mut())
+        .chain(self.accelerations_parameter_tangent.as_mut());
         let walls = self.walls.iter_mut().flat_map(|w| {
             [
                 &mut w.surface,
@@ -256,6 +266,8 @@ impl<const N: usize> Interpreted<N> {
             .chain(w.projector.as_mut())
             .chain(w.collide.as_mut())
             .chain(w.collide_tangent.as_mut())
+            .chain(w.collide_parameter_tangent.as_mut())
+            .chain(w.surface_parameter_tangent.as_mut())
         });
         model.chain(walls)
     }
@@ -280,8 +292,8 @@ impl<const N: usize> Interpreted<N> {
 
     /// A tangent program's values and derivatives at (q, v) along
     /// (dq, dv).
-    fn tangent(&self, c: &Compiled, [q, v, dq, dv]: [&[f64; N]; 4]) -> ([f64; N], [f64; N]) {
-        c.eval_parts(self.np(), &[q, v, dq, dv], |o| {
+    fn tangent(&self, c: &Compiled, parts: &[&[f64]]) -> ([f64; N], [f64; N]) {
+        c.eval_parts(self.np(), parts, |o| {
             let m = o.len() / 2;
             let at = |i: usize| if i < m { o[i] } else { 0.0 };
             (
@@ -404,7 +416,17 @@ impl<const N: usize> Walls<N, N> for Interpreted<N> {
         dv: &[f64; N],
     ) -> Option<([f64; N], [f64; N])> {
         let c = self.wall(wall).collide_tangent.as_ref()?;
-        Some(self.tangent(c, [q, v, dq, dv]))
+        Some(self.tangent(c, &[q, v, dq, dv]))
+    }
+    fn collide_parameter_tangent(
+        &self,
+        wall: WallIndex,
+        q: &[f64; N],
+        v: &[f64; N],
+        dp: &[f64],
+    ) -> Option<([f64; N], [f64; N])> {
+        let c = self.wall(wall).collide_parameter_tangent.as_ref()?;
+        (dp.len() == self.np()).then(|| self.tangent(c, &[q, v, dp]))
     }
     fn normal(&self, wall: WallIndex, q: &[f64; N]) -> [f64; N] {
         self.vector(&self.wall(wall).normal, q, &[])
@@ -450,7 +472,16 @@ impl<const N: usize> Dynamics<N> for Interpreted<N> {
         dv: &[f64; N],
     ) -> Option<([f64; N], [f64; N])> {
         let c = self.accelerations_tangent.as_ref()?;
-        Some(self.tangent(c, [q, v, dq, dv]))
+        Some(self.tangent(c, &[q, v, dq, dv]))
+    }
+    fn accelerations_parameter_tangent(
+        &self,
+        q: &[f64; N],
+        v: &[f64; N],
+        dp: &[f64],
+    ) -> Option<([f64; N], [f64; N])> {
+        let c = self.accelerations_parameter_tangent.as_ref()?;
+        (dp.len() == self.np()).then(|| self.tangent(c, &[q, v, dp]))
     }
     /// The interpreter keeps its room itself (`SeriesPrograms::workspace`,
     /// sized by the first call and reused by every simulator after it).
@@ -480,6 +511,22 @@ impl<const N: usize> Surfaces<N> for Interpreted<N> {
     }
     fn surface_hessian(&self, wall: WallIndex, q: &[f64; N], v: &[f64; N]) -> Option<f64> {
         Some(self.scalar(&self.wall(wall).surface_hessian, q, v))
+    }
+    fn surface_parameter_tangent(
+        &self,
+        wall: WallIndex,
+        q: &[f64; N],
+        dp: &[f64],
+    ) -> Option<(f64, f64)> {
+        let c = self.wall(wall).surface_parameter_tangent.as_ref()?;
+        (dp.len() == self.np()).then(|| {
+            c.eval_parts(self.np(), &[q, dp], |o| {
+                (
+                    o.first().copied().unwrap_or(0.0),
+                    o.get(1).copied().unwrap_or(0.0),
+                )
+            })
+        })
     }
     fn surface_bounds(&self, wall: WallIndex, q: &[Interval; N]) -> Option<Interval> {
         let f = &self.wall(wall).surface;

@@ -24,6 +24,20 @@ impl Program {
     /// Every value is written once (the program in static single
     /// assignment), so that a rule may read its operands and its result.
     pub fn tangent(&self, from: usize) -> Program {
+        self.tangent_over(from..self.inputs)
+    }
+
+    /// The tangent program along the inputs `along` (a range of this
+    /// program's inputs; the rest are held fixed): its inputs are this
+    /// program's followed by a direction, one input for each of `along`
+    /// (in the same order); its outputs are this program's followed by
+    /// their derivatives along the direction. With `along` the parameters,
+    /// the derivatives are by the parameters at a fixed state.
+    pub fn tangent_over(&self, along: std::ops::Range<usize>) -> Program {
+        assert!(
+            along.end <= self.inputs,
+            "a direction for each input differentiated"
+        );
         let mut t = Tangent {
             consts: self.consts.clone(),
             instrs: Vec::new(),
@@ -32,8 +46,9 @@ impl Program {
             tangent: HashMap::new(),
             computed: HashMap::new(),
         };
-        for i in from..self.inputs {
-            let direction = Slot::Input(self.inputs + i - from);
+        let directions = along.len();
+        for (k, i) in along.enumerate() {
+            let direction = Slot::Input(self.inputs + k);
             t.tangent.insert(Slot::Input(i), direction);
         }
         for ins in &self.instrs {
@@ -49,10 +64,30 @@ impl Program {
                 .push(Instr::Assign(Slot::Out(self.outputs + k), derivative));
         }
         Program {
-            inputs: 2 * self.inputs - from,
+            inputs: self.inputs + directions,
             consts: t.consts,
             instrs: t.instrs,
             outputs: 2 * self.outputs,
+        }
+    }
+}
+
+impl Program {
+    /// The same program with `width` inputs: where a program was made over
+    /// more inputs than its quantity takes (f(q) built over (q, v)), the
+    /// tangent's direction then follows the inputs it does take.
+    ///
+    /// # Panics
+    /// If the program reads an input at or past `width`.
+    pub fn with_inputs(&self, width: usize) -> Program {
+        let past = |s: &Slot| matches!(s, Slot::Input(k) if *k >= width);
+        assert!(
+            !self.instrs.iter().any(|i| i.sources().iter().any(past)),
+            "the program reads an input past {width}"
+        );
+        Program {
+            inputs: width,
+            ..self.clone()
         }
     }
 }
@@ -332,6 +367,38 @@ mod tests {
                 );
             }
             assert_eq!(out[6], 0.0, "p² does not move with x and y");
+        }
+    }
+
+    /// Along the parameter alone, at a fixed (x, y): against central
+    /// differences in p; 1.5 − x does not move with p.
+    #[test]
+    fn tangent_over_the_parameter() {
+        let p = sample();
+        let t = p.tangent_over(0..1);
+        assert_eq!((t.inputs, t.outputs), (4, 8));
+        for point in [[0.7, 0.3, 1.2], [-1.1, 2.0, 0.4]] {
+            let mut inputs = point.to_vec();
+            inputs.push(1.0);
+            let out = t.eval(&inputs);
+            assert_eq!(out[..4], p.eval(&point)[..], "the values themselves");
+            let h = 1e-5;
+            let at = |s: f64| {
+                let mut z = point;
+                z[0] += s;
+                p.eval(&z)
+            };
+            let (plus, minus) = (at(h), at(-h));
+            for k in 0..4 {
+                let fd = (plus[k] - minus[k]) / (2.0 * h);
+                let got = out[4 + k];
+                assert!(
+                    (got - fd).abs() <= 1e-6 * (1.0 + fd.abs()),
+                    "output {k}: tangent {got}, differences {fd}"
+                );
+            }
+            assert_eq!(out[6], 2.0 * point[0], "d(p²)/dp");
+            assert_eq!(out[7], 0.0, "1.5 − x does not move with p");
         }
     }
 }

@@ -16,9 +16,10 @@
 //   floor_projector              0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   floor_collide                4 add, 9 mul, 0 div, 0 fn (13 in all)
 //   floor_collide_tangent        8 add, 18 mul, 0 div, 0 fn (26 in all)
+//   floor_collide_parameter_tangent 15 add, 32 mul, 0 div, 0 fn (47 in all)
 //
-// Parameter-only work, done once when the parameters are set (15 values kept):
-//   all functions                5 add, 31 mul, 3 div, 0 fn (39 in all)
+// Parameter-only work, done once when the parameters are set (28 values kept):
+//   all functions                7 add, 48 mul, 4 div, 0 fn (59 in all)
 //
 // Solves, the cheapest form per call (cost: add + mul + 4 div + 20 fn):
 //   floor_collide                M v, M = I - 2P kept with the parameters [linear 13, closed form 15, elimination 23]
@@ -60,7 +61,7 @@ pub struct BallFloor {
     /// `set_parameter`, which keep `pre` up to date).
     params: Params,
     /// The parameter-only values the functions read.
-    pre: [f64; 15],
+    pre: [f64; 28],
 }
 impl Default for BallFloor {
     /// The model with the model file's parameter values.
@@ -119,8 +120,8 @@ impl BallFloor {
     }
     /// The parameter-only values the functions read, from `params`.
     #[allow(unused_variables, unused_mut, clippy::approx_constant)]
-    fn precompute(params: &Params) -> [f64; 15] {
-        let mut pre: [f64; 15] = [0.0; 15];
+    fn precompute(params: &Params) -> [f64; 28] {
+        let mut pre: [f64; 28] = [0.0; 28];
         {
             let i1: f64 = params.r;
             let o10: f64 = -(i1);
@@ -190,6 +191,35 @@ impl BallFloor {
             pre[13] = t9;
             let t10: f64 = i0 * t7;
             pre[14] = t10;
+        }
+        {
+            let i0: f64 = params.m;
+            let i1: f64 = params.r;
+            let i2: f64 = params.J;
+            let t0: f64 = i1 * i1;
+            pre[15] = t0;
+            pre[16] = 2f64 * i1;
+            let t2: f64 = i0 * t0;
+            let t6: f64 = i2 + t2;
+            let t8: f64 = 1.0 / (t6);
+            pre[17] = t8;
+            pre[18] = -(t8 * t8);
+            let t10: f64 = i2 * -2f64 * t8;
+            pre[19] = -2f64 * t8;
+            pre[20] = i2 * -2f64;
+            let t14: f64 = 1f64 + t10;
+            pre[21] = t14;
+            let t15: f64 = i1 * t8;
+            let t19: f64 = 2f64 * t15;
+            pre[22] = t19;
+            let t21: f64 = i2 * t19;
+            pre[23] = t21;
+            let t25: f64 = i0 * -2f64 * t15;
+            pre[24] = t25;
+            pre[25] = -2f64 * t15;
+            pre[26] = i0 * -2f64;
+            let t29: f64 = i0 * t19;
+            pre[27] = t29;
         }
         pre
     }
@@ -486,6 +516,95 @@ impl BallFloor {
         let o11: f64 = i14;
         ([o0, o1, o2, o3, o4, o5], [o6, o7, o8, o9, o10, o11])
     }
+    /// Wall `floor`: v⁺ as `collide` computes it, and its derivative along a direction δp of the parameters (in `PARAMETERS` order) at fixed (q, v⁻): (v⁺, ∂v⁺/∂p δp), by forward differentiation of the same program.
+    #[inline]
+    #[allow(unused_variables, clippy::approx_constant)]
+    pub fn floor_collide_parameter_tangent(
+        &self,
+        q: &[f64; 0],
+        v: &[f64; 6],
+        dp: &[f64; 3],
+    ) -> ([f64; 6], [f64; 6]) {
+        let i0: f64 = self.params.m;
+        let i1: f64 = self.params.r;
+        let i2: f64 = self.params.J;
+        let i3: f64 = v[0];
+        let i4: f64 = v[1];
+        let i5: f64 = v[2];
+        let i6: f64 = v[3];
+        let i7: f64 = v[4];
+        let i8: f64 = v[5];
+        let i9: f64 = dp[0];
+        let i10: f64 = dp[1];
+        let i11: f64 = dp[2];
+        let t0: f64 = self.pre[15];
+        let t1: f64 = self.pre[16] * i10;
+        let t3: f64 = t0 * i9;
+        let t4: f64 = i0 * t1;
+        let t5: f64 = t3 + t4;
+        let t7: f64 = i11 + t5;
+        let t8: f64 = self.pre[17];
+        let t9: f64 = self.pre[18] * t7;
+        let t11: f64 = self.pre[19] * i11;
+        let t12: f64 = self.pre[20] * t9;
+        let t13: f64 = t11 + t12;
+        let t14: f64 = self.pre[21];
+        let t16: f64 = t8 * i10;
+        let t17: f64 = i1 * t9;
+        let t18: f64 = t16 + t17;
+        let t19: f64 = self.pre[22];
+        let t20: f64 = 2f64 * t18;
+        let t21: f64 = self.pre[23];
+        let t22: f64 = t19 * i11;
+        let t23: f64 = i2 * t20;
+        let t24: f64 = t22 + t23;
+        let t25: f64 = self.pre[24];
+        let t26: f64 = self.pre[25] * i9;
+        let t27: f64 = self.pre[26] * t18;
+        let t28: f64 = t26 + t27;
+        let t29: f64 = self.pre[27];
+        let t30: f64 = t19 * i9;
+        let t31: f64 = i0 * t20;
+        let t32: f64 = t30 + t31;
+        let t33: f64 = t14 * i3;
+        let t34: f64 = i3 * t13;
+        let t35: f64 = t21 * i7;
+        let t36: f64 = i7 * t24;
+        let t37: f64 = t33 + t35;
+        let t38: f64 = t34 + t36;
+        let t39: f64 = t14 * i4;
+        let t40: f64 = i4 * t13;
+        let t41: f64 = t21 * i6;
+        let t42: f64 = i6 * t24;
+        let t43: f64 = t39 - t41;
+        let t44: f64 = t40 - t42;
+        let t45: f64 = -(i5);
+        let t46: f64 = t25 * i4;
+        let t47: f64 = i4 * t28;
+        let t48: f64 = t14 * i6;
+        let t49: f64 = i6 * t13;
+        let t50: f64 = t46 - t48;
+        let t51: f64 = t47 - t49;
+        let t52: f64 = t29 * i3;
+        let t53: f64 = i3 * t32;
+        let t54: f64 = t14 * i7;
+        let t55: f64 = i7 * t13;
+        let t56: f64 = t52 - t54;
+        let t57: f64 = t53 - t55;
+        let o0: f64 = t37;
+        let o6: f64 = t38;
+        let o1: f64 = t43;
+        let o7: f64 = t44;
+        let o2: f64 = t45;
+        let o8: f64 = 0f64;
+        let o3: f64 = t50;
+        let o9: f64 = t51;
+        let o4: f64 = t56;
+        let o10: f64 = t57;
+        let o5: f64 = i8;
+        let o11: f64 = 0f64;
+        ([o0, o1, o2, o3, o4, o5], [o6, o7, o8, o9, o10, o11])
+    }
 }
 impl ::dalembert_runtime::Model<0, 6> for BallFloor {
     fn name(&self) -> &str {
@@ -601,6 +720,21 @@ impl ::dalembert_runtime::Walls<0, 6> for BallFloor {
     ) -> Option<([f64; 6], [f64; 6])> {
         match wall {
             Wall::Floor => Some(self.floor_collide_tangent(q, v, dq, dv)),
+        }
+    }
+    #[inline]
+    fn collide_parameter_tangent(
+        &self,
+        wall: Wall,
+        q: &[f64; 0],
+        v: &[f64; 6],
+        dp: &[f64],
+    ) -> Option<([f64; 6], [f64; 6])> {
+        let Ok(dp) = <&[f64; 3]>::try_from(dp) else {
+            return None;
+        };
+        match wall {
+            Wall::Floor => Some(self.floor_collide_parameter_tangent(q, v, dp)),
         }
     }
 }

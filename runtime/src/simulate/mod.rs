@@ -77,7 +77,7 @@ pub use integrator::{DormandPrince, Integrator, Rk4, Taylor};
 pub use projection::{StartRule, admissible, residual, starting_velocity, tangent_direction};
 pub use return_map::{Return, ReturnError, Section, return_map};
 pub use types::{Collision, Residual, Settings, SimError, State, Stats, Step};
-pub use variational::{Variational, VariationalError};
+pub use variational::{ParameterSensitivity, Variational, VariationalError};
 
 use crate::Surfaces;
 use crate::dynamics::{accelerations, qdd};

@@ -28,13 +28,18 @@
 //! simulation's derivative along every admissible δx₀; other columns of Φ
 //! describe the flow of the equations extended off the manifold.
 //!
+//! [`ParameterSensitivity`] carries one more column the same way: the
+//! derivative of the run along a direction δp of the parameters, whose
+//! equation adds ∂q̈/∂p δp and whose collisions add the jump of
+//! [`parameter_jump`].
+//!
 //! [`Dynamics::accelerations_tangent`]: crate::Dynamics::accelerations_tangent
 
 use super::integrator::{DormandPrince, Engine, Method, RungeKutta};
 use super::phase::{Combine, Dual, Phase};
-use super::{Simulator, Step};
+use super::{LastStep, Simulator, Step};
 use crate::Surfaces;
-use crate::saltation::{SaltationError, StateMatrix, saltation};
+use crate::saltation::{SaltationError, StateMatrix, parameter_jump, saltation};
 
 /// Φ along a simulation (see the module doc). Start it at the simulator's
 /// start and call [`Variational::follow`] after every step:
@@ -64,9 +69,14 @@ pub struct Variational<const N: usize> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum VariationalError<W> {
     /// The model has no tangent of q̈ ([`Dynamics::accelerations_tangent`]
-    /// is `None`).
+    /// is `None`), or, for [`ParameterSensitivity`], none by the
+    /// parameters along its direction
+    /// ([`Dynamics::accelerations_parameter_tangent`] is `None`: no q̈
+    /// written out, or a direction whose length is not the number of
+    /// parameters).
     ///
     /// [`Dynamics::accelerations_tangent`]: crate::Dynamics::accelerations_tangent
+    /// [`Dynamics::accelerations_parameter_tangent`]: crate::Dynamics::accelerations_parameter_tangent
     NoDerivative,
     /// The step is not the simulator's last (its motion is gone).
     NotTheLastStep,
@@ -122,48 +132,9 @@ impl<const N: usize> Variational<N> {
         sim: &Simulator<'_, M, N>,
         step: &Step<M::Wall, N>,
     ) -> Result<(), VariationalError<M::Wall>> {
-        let t1 = step.collision.as_ref().map_or(step.state.t, |c| c.t);
-        if t1 > step.t0 {
-            let last = sim
-                .last
-                .as_ref()
-                .filter(|last| last.t0 == step.t0)
-                .ok_or(VariationalError::NotTheLastStep)?;
-            let model = sim.model();
+        if let Some(flight) = Flight::of(sim, step)? {
             for j in 0..2 * N {
-                let column = self.column(j);
-                let column = match (&sim.engine, &last.interpolant) {
-                    (Engine::RungeKutta(method), Some((_, dense))) => {
-                        // The simulator's method, held to Φ's tolerance
-                        // (Dormand–Prince; RK4 has no error estimate), tried
-                        // first over the simulator's own step.
-                        let method = match method {
-                            RungeKutta::DormandPrince(_) => RungeKutta::DormandPrince(self.method),
-                            rk4 => *rk4,
-                        };
-                        let start = Dual {
-                            x: *dense.start(),
-                            dx: column,
-                        };
-                        let mut rhs = |_: f64, y: &Dual<N>| tangent(model, y);
-                        controlled(&method, &mut rhs, start, step.t0, t1, t1 - step.t0)?
-                            .0
-                            .dx
-                    }
-                    _ => {
-                        let (t0, method) = (step.t0, RungeKutta::DormandPrince(self.method));
-                        let mut rhs = |t: f64, d: &Phase<N>| {
-                            let x = sim
-                                .state_at(t.clamp(t0, t1))
-                                .ok_or(VariationalError::NotTheLastStep)?;
-                            let (x, dx) = (Phase { q: x.q, v: x.v }, *d);
-                            Ok(tangent(model, &Dual { x, dx })?.dx)
-                        };
-                        let (column, h) = controlled(&method, &mut rhs, column, t0, t1, self.h)?;
-                        self.h = h;
-                        column
-                    }
-                };
+                let column = flight.carry(self.column(j), tangent, self.method, &mut self.h)?;
                 self.set_column(j, &column);
             }
         }
@@ -207,6 +178,181 @@ impl<const N: usize> Variational<N> {
     }
 }
 
+/// The derivative of a simulation along a direction δp of the parameters
+/// (one entry each, in [`crate::Model::parameter_names`] order), with the
+/// starting state held fixed: s(t) = ∂x(t)/∂p δp for x = (q, q̇), through
+/// collisions. Between them s is carried as a column of Φ is
+/// ([`Variational`]), with ∂q̈/∂p δp added to its equation
+/// ([`Dynamics::accelerations_parameter_tangent`]); at a collision
+/// s⁺ = S s⁻ + the jump of [`parameter_jump`] (the map's and the wall's
+/// own change with p). For a start that depends on the parameters, give
+/// its derivative along δp as the starting value ([`Self::starting_at`]).
+///
+/// ```ignore
+/// let dp = [0.0, 1.0]; // ∂/∂ of the second parameter
+/// let mut s = ParameterSensitivity::new(&dp, 1e-10);
+/// while sim.state().t < t_end {
+///     let step = sim.step(t_end)?;
+///     s.follow(&sim, &step)?;
+/// }
+/// let (dq, dv) = s.value();
+/// ```
+///
+/// [`Dynamics::accelerations_parameter_tangent`]: crate::Dynamics::accelerations_parameter_tangent
+#[derive(Clone, Copy, Debug)]
+pub struct ParameterSensitivity<'p, const N: usize> {
+    dp: &'p [f64],
+    s: Phase<N>,
+    before: Phase<N>,
+    method: DormandPrince,
+    h: f64,
+}
+
+impl<'p, const N: usize> ParameterSensitivity<'p, N> {
+    /// s = 0 (the start does not move with p); `rtol` as for
+    /// [`Variational::new`].
+    pub fn new(dp: &'p [f64], rtol: f64) -> Self {
+        let v = Variational::<N>::new(rtol);
+        Self {
+            dp,
+            s: Phase::ZERO,
+            before: Phase::ZERO,
+            method: v.method,
+            h: v.h,
+        }
+    }
+
+    /// The same, starting from s = (δq₀, δv₀): the start's own derivative
+    /// along δp.
+    pub fn starting_at(mut self, dq: [f64; N], dv: [f64; N]) -> Self {
+        self.s = Phase { q: dq, v: dv };
+        self.before = self.s;
+        self
+    }
+
+    /// s so far: (∂q/∂p δp, ∂q̇/∂p δp).
+    pub fn value(&self) -> ([f64; N], [f64; N]) {
+        (self.s.q, self.s.v)
+    }
+
+    /// s just before the last step's collision (the value itself when the
+    /// step met no wall).
+    pub fn before_collision(&self) -> ([f64; N], [f64; N]) {
+        (self.before.q, self.before.v)
+    }
+
+    /// Advances s over `step`, the step `sim` has just made: along its
+    /// motion, then through its collision if it ended at one.
+    pub fn follow<M: Surfaces<N>>(
+        &mut self,
+        sim: &Simulator<'_, M, N>,
+        step: &Step<M::Wall, N>,
+    ) -> Result<(), VariationalError<M::Wall>> {
+        if let Some(flight) = Flight::of(sim, step)? {
+            let dp = self.dp;
+            let derivative = |m: &M, y: &Dual<N>| parameter_tangent(m, y, dp);
+            self.s = flight.carry(self.s, derivative, self.method, &mut self.h)?;
+        }
+        self.before = self.s;
+        if let Some(c) = &step.collision {
+            let model = sim.model();
+            let error = |error| VariationalError::Saltation {
+                wall: c.wall,
+                error,
+            };
+            let salt = saltation(model, c.wall, &c.q, &c.v_minus).map_err(error)?;
+            let jump = parameter_jump(model, c.wall, &c.q, &c.v_minus, self.dp).map_err(error)?;
+            let (q, v) = salt.matrix.apply(&self.s.q, &self.s.v);
+            self.s = Phase {
+                q: core::array::from_fn(|i| q[i] + jump.dx.0[i]),
+                v: core::array::from_fn(|i| v[i] + jump.dx.1[i]),
+            };
+        }
+        Ok(())
+    }
+}
+
+/// The motion of one step up to its collision (or its end), along which
+/// tangents are carried.
+struct Flight<'s, 'm, M: Surfaces<N>, const N: usize> {
+    sim: &'s Simulator<'m, M, N>,
+    last: &'s LastStep<N>,
+    t0: f64,
+    t1: f64,
+}
+
+impl<'s, 'm, M: Surfaces<N>, const N: usize> Flight<'s, 'm, M, N> {
+    /// `step`'s flight, `None` when it has none (a collision at its start);
+    /// an error when `step` is not `sim`'s last.
+    fn of(
+        sim: &'s Simulator<'m, M, N>,
+        step: &Step<M::Wall, N>,
+    ) -> Result<Option<Self>, VariationalError<M::Wall>> {
+        let t1 = step.collision.as_ref().map_or(step.state.t, |c| c.t);
+        if t1 <= step.t0 {
+            return Ok(None);
+        }
+        let last = sim
+            .last
+            .as_ref()
+            .filter(|last| last.t0 == step.t0)
+            .ok_or(VariationalError::NotTheLastStep)?;
+        Ok(Some(Self {
+            sim,
+            last,
+            t0: step.t0,
+            t1,
+        }))
+    }
+
+    /// A tangent δx at the step's start carried to its flight's end by
+    /// `derivative`, (ẋ, δẋ) at (x, δx) ([`tangent`], or
+    /// [`parameter_tangent`] along a direction of the parameters):
+    /// through the step itself for a Runge–Kutta step, else along its
+    /// polynomial by `method` from a first step of `h` (updated to the
+    /// last one taken). See the module doc.
+    fn carry(
+        &self,
+        column: Phase<N>,
+        derivative: impl Fn(&M, &Dual<N>) -> Result<Dual<N>, VariationalError<M::Wall>>,
+        method: DormandPrince,
+        h: &mut f64,
+    ) -> Result<Phase<N>, VariationalError<M::Wall>> {
+        let (sim, t0, t1) = (self.sim, self.t0, self.t1);
+        let model = sim.model();
+        match (&sim.engine, &self.last.interpolant) {
+            (Engine::RungeKutta(rk), Some((_, dense))) => {
+                // The simulator's method, held to Φ's tolerance
+                // (Dormand–Prince; RK4 has no error estimate), tried first
+                // over the simulator's own step.
+                let rk = match rk {
+                    RungeKutta::DormandPrince(_) => RungeKutta::DormandPrince(method),
+                    rk4 => *rk4,
+                };
+                let start = Dual {
+                    x: *dense.start(),
+                    dx: column,
+                };
+                let mut rhs = |_: f64, y: &Dual<N>| derivative(model, y);
+                Ok(controlled(&rk, &mut rhs, start, t0, t1, t1 - t0)?.0.dx)
+            }
+            _ => {
+                let mut rhs = |t: f64, d: &Phase<N>| {
+                    let x = sim
+                        .state_at(t.clamp(t0, t1))
+                        .ok_or(VariationalError::NotTheLastStep)?;
+                    let (x, dx) = (Phase { q: x.q, v: x.v }, *d);
+                    Ok(derivative(model, &Dual { x, dx })?.dx)
+                };
+                let rk = RungeKutta::DormandPrince(method);
+                let (column, last) = controlled(&rk, &mut rhs, column, t0, t1, *h)?;
+                *h = last;
+                Ok(column)
+            }
+        }
+    }
+}
+
 /// (ẋ, J(x) δx) at (x, δx): one tangent of q̈.
 fn tangent<M: Surfaces<N>, const N: usize>(
     model: &M,
@@ -219,6 +365,21 @@ fn tangent<M: Surfaces<N>, const N: usize>(
         x: Phase { q: y.x.v, v: qdd },
         dx: Phase { q: y.dx.v, v: dqdd },
     })
+}
+
+/// (ẋ, J(x) δx + ∂F/∂p δp) at (x, δx): [`tangent`] and the tangent of q̈
+/// along the direction δp of the parameters.
+fn parameter_tangent<M: Surfaces<N>, const N: usize>(
+    model: &M,
+    y: &Dual<N>,
+    dp: &[f64],
+) -> Result<Dual<N>, VariationalError<M::Wall>> {
+    let mut d = tangent(model, y)?;
+    let (_, by_p) = model
+        .accelerations_parameter_tangent(&y.x.q, &y.x.v, dp)
+        .ok_or(VariationalError::NoDerivative)?;
+    d.dx.v.iter_mut().zip(by_p).for_each(|(d, p)| *d += p);
+    Ok(d)
 }
 
 /// y from t0 to t1 by `method` under its error control (one step of the

@@ -10,6 +10,7 @@ use super::super::body::{self, Place};
 use super::pairs::{self, Plan};
 use crate::plan::computed;
 use crate::program::{Op, Slot, Transform};
+use crate::quantity::Inputs;
 
 /// `SeriesScratch`: room for the intermediate series of every function
 /// above, one pool they share (they never run at once), as long as the
@@ -90,7 +91,13 @@ fn arrays(t: &Transform) -> Vec<proc_macro2::Ident> {
 /// The time-constant values, the intermediate series (single coefficients
 /// on the stack, whole arrays in `scratch`) and the lanes of `plan`.
 pub(super) fn prelude(d: &Ctx, t: &Transform, plan: &Plan) -> TokenStream {
-    let numbers = body::statements(d, &t.numbers, &computed(&t.numbers), Place::Call);
+    let numbers = body::statements(
+        d,
+        &t.numbers,
+        &computed(&t.numbers),
+        Inputs::Phase,
+        Place::Call,
+    );
     // Series operations read parameters directly too (a product with m);
     // those the numbers read are bound by their statements.
     let read: Vec<Slot> = t

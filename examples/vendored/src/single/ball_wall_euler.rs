@@ -23,8 +23,10 @@
 //   constraint_drift             4 add, 14 mul, 0 div, 4 fn (22 in all)
 //   accelerations                5 add, 18 mul, 1 div, 4 fn (28 in all)
 //   accelerations_tangent        19 add, 60 mul, 1 div, 4 fn (84 in all)
+//   accelerations_parameter_tangent 17 add, 47 mul, 1 div, 4 fn (69 in all)
 //   initial_state                0 add, 1 mul, 0 div, 0 fn (1 in all)
 //   wall_surface                 1 add, 0 mul, 0 div, 0 fn (1 in all)
+//   wall_surface_parameter_tangent 1 add, 1 mul, 0 div, 0 fn (2 in all)
 //   wall_normal                  0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   wall_normal_velocity         0 add, 0 mul, 0 div, 0 fn (0 in all)
 //   wall_surface_hessian         0 add, 0 mul, 0 div, 0 fn (0 in all)
@@ -32,9 +34,10 @@
 //   wall_projector               10 add, 40 mul, 1 div, 4 fn (55 in all)
 //   wall_collide                 25 add, 55 mul, 1 div, 4 fn (85 in all)
 //   wall_collide_tangent         73 add, 155 mul, 1 div, 4 fn (233 in all)
+//   wall_collide_parameter_tangent 61 add, 139 mul, 1 div, 4 fn (205 in all)
 //
-// Parameter-only work, done once when the parameters are set (59 values kept):
-//   all functions                10 add, 70 mul, 8 div, 0 fn (88 in all)
+// Parameter-only work, done once when the parameters are set (92 values kept):
+//   all functions                14 add, 107 mul, 10 div, 0 fn (131 in all)
 //
 // Solves, the cheapest form per call (cost: add + mul + 4 div + 20 fn):
 //   wall_collide                 the exact closed form [closed form 164, elimination 220]
@@ -89,7 +92,7 @@ pub struct BallWallEuler {
     /// `set_parameter`, which keep `pre` up to date).
     params: Params,
     /// The parameter-only values the functions read.
-    pre: [f32; 59],
+    pre: [f32; 92],
 }
 impl Default for BallWallEuler {
     /// The model with the model file's parameter values.
@@ -147,8 +150,8 @@ impl BallWallEuler {
     }
     /// The parameter-only values the functions read, from `params`.
     #[allow(unused_variables, unused_mut, clippy::approx_constant)]
-    fn precompute(params: &Params) -> [f32; 59] {
-        let mut pre: [f32; 59] = [0.0; 59];
+    fn precompute(params: &Params) -> [f32; 92] {
+        let mut pre: [f32; 92] = [0.0; 92];
         {
             let i0: f32 = params.m;
             let i1: f32 = params.r;
@@ -216,14 +219,46 @@ impl BallWallEuler {
             let o0: f32 = t5;
         }
         {
+            let i0: f32 = params.m;
+            let i1: f32 = params.r;
+            let i2: f32 = params.J;
+            let i4: f32 = params.a;
+            let t0: f32 = i1 * i1;
+            pre[16] = t0;
+            pre[17] = 2f32 * i1;
+            let t2: f32 = i0 * t0;
+            let t6: f32 = i2 + t2;
+            pre[18] = t6;
+            let t8: f32 = 1.0 / (t6);
+            pre[19] = t8;
+            pre[20] = -(t8 * t8);
+            let t10: f32 = -(i4);
+            let t12: f32 = t2 * t8 * t10;
+            pre[28] = t12;
+            pre[21] = t8 * t10;
+            pre[22] = t2 * t10;
+            pre[23] = t2 * t8;
+            let t17: f32 = i0 * i1 * t10;
+            pre[24] = t17;
+            pre[25] = i1 * t10;
+            pre[26] = i0 * t10;
+            pre[27] = i0 * i1;
+            let o0: f32 = t12;
+        }
+        {
             let i1: f32 = params.r;
             let o0: f32 = -(i1);
-            pre[16] = o0;
+            pre[29] = o0;
+        }
+        {
+            let i1: f32 = params.r;
+            let t0: f32 = -(i1);
+            pre[30] = t0;
         }
         {
             let i1: f32 = params.r;
             let o17: f32 = -(i1);
-            pre[17] = o17;
+            pre[31] = o17;
         }
         {
             let i0: f32 = params.m;
@@ -232,32 +267,32 @@ impl BallWallEuler {
             let t6: f32 = i1 * i1;
             let t6: f32 = i0 * t6;
             let t8: f32 = i2 * 2f32;
-            pre[18] = t8;
+            pre[32] = t8;
             let t4: f32 = t6 + t8;
-            pre[19] = t4;
+            pre[33] = t4;
             let t3: f32 = 1.0 / (t4);
-            pre[20] = t3;
+            pre[34] = t3;
             let t10: f32 = i2 * t3;
-            pre[21] = t10;
+            pre[35] = t10;
             let t0: f32 = 2f32 * t10;
-            pre[30] = t0;
+            pre[44] = t0;
             let t5: f32 = -(i1);
             let t1: f32 = t10 * t5;
-            pre[31] = t1;
+            pre[45] = t1;
             let t2: f32 = i1 * i2;
             let t5: f32 = i0 * t5;
-            pre[22] = t5;
+            pre[36] = t5;
             let t6: f32 = i2 + t6;
-            pre[23] = t6;
+            pre[37] = t6;
             let t7: f32 = -(i2);
-            pre[24] = t7;
+            pre[38] = t7;
             let t9: f32 = i0 * i1 * t3;
-            pre[25] = t9;
-            pre[26] = -(t1);
-            pre[27] = t2 * t3;
+            pre[39] = t9;
+            pre[40] = -(t1);
+            pre[41] = t2 * t3;
             let t15: f32 = 1.0 / (t4);
-            pre[28] = t15;
-            pre[29] = -(t5);
+            pre[42] = t15;
+            pre[43] = -(t5);
             let o6: f32 = t0;
             let o7: f32 = t1;
         }
@@ -266,74 +301,116 @@ impl BallWallEuler {
             let i1: f32 = params.r;
             let i2: f32 = params.J;
             let t0: f32 = i1 * i2;
-            pre[32] = t0;
+            pre[46] = t0;
             let t6: f32 = i1 * i1;
             let t6: f32 = i0 * t6;
             let t8: f32 = i2 * 2f32;
-            pre[33] = t8;
+            pre[47] = t8;
             let t4: f32 = t6 + t8;
-            pre[34] = t4;
+            pre[48] = t4;
             let t3: f32 = 1.0 / (t4);
             let t2: f32 = i2 * t3;
             let t1: f32 = i1 * 2f32 * t2;
-            pre[35] = t1;
+            pre[49] = t1;
             let t2: f32 = -4f32 * t2;
             let t2: f32 = 1f32 + t2;
-            pre[36] = t2;
+            pre[50] = t2;
             let t3: f32 = -2f32 * t3;
-            pre[37] = t3;
+            pre[51] = t3;
             let t11: f32 = i0 * i1;
             let t5: f32 = -(t11);
-            pre[38] = t5;
+            pre[52] = t5;
             let t6: f32 = i2 + t6;
-            pre[39] = t6;
+            pre[53] = t6;
             let t7: f32 = -(i2);
-            pre[40] = t7;
+            pre[54] = t7;
             let t9: f32 = t3 * t11;
-            pre[41] = t9;
+            pre[55] = t9;
             let t10: f32 = i2 * t3;
-            pre[42] = t10;
+            pre[56] = t10;
             let t11: f32 = -2f32 * t11;
-            pre[43] = t11;
+            pre[57] = t11;
             let t18: f32 = 1.0 / (t4);
-            pre[44] = t18;
+            pre[58] = t18;
         }
         {
             let i0: f32 = params.m;
             let i1: f32 = params.r;
             let i2: f32 = params.J;
             let t0: f32 = i1 * i2;
-            pre[45] = t0;
+            pre[59] = t0;
             let t1: f32 = i1 * i1;
             let t2: f32 = i0 * t1;
             let t3: f32 = i2 * 2f32;
-            pre[46] = t3;
+            pre[60] = t3;
             let t4: f32 = t2 + t3;
-            pre[47] = t4;
+            pre[61] = t4;
             let t5: f32 = 1.0 / (t4);
-            pre[48] = t5;
+            pre[62] = t5;
             let t6: f32 = i2 * t5;
             let t7: f32 = i1 * 2f32 * t6;
-            pre[49] = t7;
+            pre[63] = t7;
             let t8: f32 = -4f32 * t6;
             let t9: f32 = 1f32 + t8;
-            pre[50] = t9;
+            pre[64] = t9;
             let t10: f32 = -2f32 * t5;
-            pre[51] = t10;
+            pre[65] = t10;
             let t11: f32 = i0 * i1;
             let t12: f32 = -(t11);
-            pre[52] = t12;
+            pre[66] = t12;
             let t13: f32 = i2 + t2;
-            pre[53] = t13;
+            pre[67] = t13;
             let t14: f32 = -(i2);
-            pre[54] = t14;
+            pre[68] = t14;
             let t15: f32 = t10 * t11;
-            pre[55] = t15;
+            pre[69] = t15;
             let t16: f32 = i2 * t10;
-            pre[56] = t16;
+            pre[70] = t16;
             let t17: f32 = -2f32 * t11;
-            pre[57] = t17;
-            pre[58] = t0 * t10;
+            pre[71] = t17;
+            pre[72] = t0 * t10;
+        }
+        {
+            let i0: f32 = params.m;
+            let i1: f32 = params.r;
+            let i2: f32 = params.J;
+            let t0: f32 = i1 * i2;
+            pre[73] = t0;
+            let t4: f32 = i1 * i1;
+            pre[74] = t4;
+            pre[75] = 2f32 * i1;
+            let t6: f32 = i0 * t4;
+            let t10: f32 = i2 * 2f32;
+            pre[76] = t10;
+            let t12: f32 = t6 + t10;
+            pre[77] = t12;
+            let t14: f32 = 1.0 / (t12);
+            pre[78] = t14;
+            pre[79] = -(t14 * t14);
+            let t16: f32 = i2 * t14;
+            let t20: f32 = i1 * 2f32 * t16;
+            pre[80] = t20;
+            pre[81] = 2f32 * t16;
+            pre[82] = i1 * 2f32;
+            let t24: f32 = -4f32 * t16;
+            let t26: f32 = 1f32 + t24;
+            pre[83] = t26;
+            let t27: f32 = -2f32 * t14;
+            pre[84] = t27;
+            let t29: f32 = i0 * i1;
+            pre[85] = t29;
+            let t33: f32 = -(t29);
+            pre[86] = t33;
+            let t35: f32 = i2 + t6;
+            pre[87] = t35;
+            let t37: f32 = -(i2);
+            pre[88] = t37;
+            let t39: f32 = t27 * t29;
+            pre[89] = t39;
+            let t43: f32 = i2 * t27;
+            pre[90] = t43;
+            let t47: f32 = -2f32 * t29;
+            pre[91] = t47;
         }
         pre
     }
@@ -701,6 +778,104 @@ impl BallWallEuler {
         let o9: f32 = t73;
         ([o0, o1, o2, o3, o4], [o5, o6, o7, o8, o9])
     }
+    /// q̈ as `accelerations` computes it, and its derivative along a direction δp of the parameters (in `PARAMETERS` order) at fixed (q, v): (q̈, ∂q̈/∂p δp), by forward differentiation of the same program.
+    #[inline]
+    #[allow(unused_variables, clippy::approx_constant)]
+    pub fn accelerations_parameter_tangent(
+        &self,
+        q: &[f32; 5],
+        v: &[f32; 5],
+        dp: &[f32; 5],
+    ) -> ([f32; 5], [f32; 5]) {
+        let i0: f32 = self.params.m;
+        let i7: f32 = q[2];
+        let i8: f32 = q[3];
+        let i12: f32 = v[2];
+        let i13: f32 = v[3];
+        let i14: f32 = v[4];
+        let i15: f32 = dp[0];
+        let i16: f32 = dp[1];
+        let i17: f32 = dp[2];
+        let i19: f32 = dp[4];
+        let t0: f32 = self.pre[16];
+        let t1: f32 = self.pre[17] * i16;
+        let t3: f32 = t0 * i15;
+        let t4: f32 = i0 * t1;
+        let t5: f32 = t3 + t4;
+        let t6: f32 = self.pre[18];
+        let t7: f32 = i17 + t5;
+        let t8: f32 = self.pre[19];
+        let t9: f32 = self.pre[20] * t7;
+        let t11: f32 = -(i19);
+        let t13: f32 = self.pre[21] * t5;
+        let t14: f32 = self.pre[22] * t9;
+        let t15: f32 = self.pre[23] * t11;
+        let t16: f32 = t13 + t14 + t15;
+        let t17: f32 = self.pre[24];
+        let t18: f32 = self.pre[25] * i15;
+        let t19: f32 = self.pre[26] * i16;
+        let t20: f32 = self.pre[27] * t11;
+        let t21: f32 = t18 + t19 + t20;
+        let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
+        let t22: f32 = sc0_cos;
+        let t23: f32 = -(t22);
+        let t24: f32 = i12 * t23;
+        let t25: f32 = i14 + t24;
+        let t26: f32 = i13 * t6;
+        let t27: f32 = i13 * t7;
+        let t28: f32 = t25 * t26;
+        let t29: f32 = t25 * t27;
+        let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
+        let t30: f32 = sc1_cos;
+        let t31: f32 = t17 * t30;
+        let t32: f32 = t30 * t21;
+        let t33: f32 = t22 * t31;
+        let t34: f32 = t22 * t32;
+        let t35: f32 = t28 + t33;
+        let t36: f32 = t29 + t34;
+        let t37: f32 = sc0_sin;
+        let t38: f32 = 1.0 / (t37);
+        let t39: f32 = t8 * t38;
+        let t40: f32 = t38 * t9;
+        let t41: f32 = t35 * t39;
+        let t42: f32 = t39 * t36;
+        let t43: f32 = t35 * t40;
+        let t44: f32 = t42 + t43;
+        let t45: f32 = -(i12 * i14 * t6 * t37);
+        let t46: f32 = -(i12 * i14 * t37 * t7);
+        let t47: f32 = sc1_sin;
+        let t48: f32 = t17 * t47;
+        let t49: f32 = t47 * t21;
+        let t50: f32 = t45 + t48;
+        let t51: f32 = t46 + t49;
+        let t52: f32 = t8 * t50;
+        let t53: f32 = t50 * t9;
+        let t54: f32 = t8 * t51;
+        let t55: f32 = t53 + t54;
+        let t56: f32 = i14 * t23;
+        let t57: f32 = i12 + t56;
+        let t58: f32 = t26 * t57;
+        let t59: f32 = t57 * t27;
+        let t60: f32 = -(t31);
+        let t61: f32 = -(t32);
+        let t62: f32 = t58 + t60;
+        let t63: f32 = t59 + t61;
+        let t64: f32 = t39 * t62;
+        let t65: f32 = t62 * t40;
+        let t66: f32 = t39 * t63;
+        let t67: f32 = t65 + t66;
+        let o0: f32 = self.pre[28];
+        let o5: f32 = t16;
+        let o1: f32 = 0f32;
+        let o6: f32 = 0f32;
+        let o2: f32 = t41;
+        let o7: f32 = t44;
+        let o3: f32 = t52;
+        let o8: f32 = t55;
+        let o4: f32 = t64;
+        let o9: f32 = t67;
+        ([o0, o1, o2, o3, o4], [o5, o6, o7, o8, o9])
+    }
     /// The starting state of the model file's `[initial]` (zero where it is silent), at these parameters: (q, q̇). The velocities it is silent on follow from the constraints (`VELOCITIES_GIVEN`, `dalembert_runtime::simulate::starting_velocity`).
     #[inline]
     #[allow(unused_variables, clippy::approx_constant)]
@@ -722,9 +897,26 @@ impl BallWallEuler {
     #[allow(unused_variables, clippy::approx_constant)]
     pub fn wall_surface(&self, q: &[f32; 5]) -> f32 {
         let i5: f32 = q[0];
-        let o0: f32 = self.pre[16];
+        let o0: f32 = self.pre[29];
         let o0: f32 = i5 + o0;
         o0
+    }
+    /// Wall `wall`: f(q) as `surface` computes it, and its derivative along a direction δp of the parameters (in `PARAMETERS` order) at fixed q: (f, ∂f/∂p δp).
+    #[inline]
+    #[allow(unused_variables, clippy::approx_constant)]
+    pub fn wall_surface_parameter_tangent(
+        &self,
+        q: &[f32; 5],
+        dp: &[f32; 5],
+    ) -> (f32, f32) {
+        let i5: f32 = q[0];
+        let i11: f32 = dp[1];
+        let t0: f32 = self.pre[30];
+        let t1: f32 = -(i11);
+        let t2: f32 = i5 + t0;
+        let o0: f32 = t2;
+        let o1: f32 = t1;
+        (o0, o1)
     }
     /// Wall `wall`: its normal df(q), the first row of B.
     #[inline]
@@ -761,7 +953,7 @@ impl BallWallEuler {
         let i8: f32 = q[3];
         let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
         let o14: f32 = sc0_sin;
-        let o17: f32 = self.pre[17];
+        let o17: f32 = self.pre[31];
         let o8: f32 = o14 * o17;
         let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
         let o19: f32 = sc1_sin;
@@ -803,17 +995,17 @@ impl BallWallEuler {
         let i2: f32 = self.params.J;
         let i7: f32 = q[2];
         let i8: f32 = q[3];
-        let t8: f32 = self.pre[18];
-        let t4: f32 = self.pre[19];
-        let t3: f32 = self.pre[20];
-        let t10: f32 = self.pre[21];
-        let t5: f32 = self.pre[22];
-        let t6: f32 = self.pre[23];
-        let t7: f32 = self.pre[24];
-        let t9: f32 = self.pre[25];
+        let t8: f32 = self.pre[32];
+        let t4: f32 = self.pre[33];
+        let t3: f32 = self.pre[34];
+        let t10: f32 = self.pre[35];
+        let t5: f32 = self.pre[36];
+        let t6: f32 = self.pre[37];
+        let t7: f32 = self.pre[38];
+        let t9: f32 = self.pre[39];
         let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
         let o23: f32 = sc0_cos;
-        let o8: f32 = self.pre[26] * o23;
+        let o8: f32 = self.pre[40] * o23;
         let o21: f32 = sc0_sin;
         let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
         let o24: f32 = sc1_sin;
@@ -821,8 +1013,8 @@ impl BallWallEuler {
         let o17: f32 = sc1_cos;
         let o9: f32 = -(o17);
         let t15: f32 = t15 + o9;
-        let o9: f32 = self.pre[27] * t15;
-        let t15: f32 = self.pre[28];
+        let o9: f32 = self.pre[41] * t15;
+        let t15: f32 = self.pre[42];
         let t18: f32 = o21 * o17;
         let o11: f32 = o24 + t18;
         let o18: f32 = 1.0 / (o24);
@@ -855,7 +1047,7 @@ impl BallWallEuler {
         let o22: f32 = o22 + o19;
         let o19: f32 = t3 * o23 * o22;
         let o22: f32 = o21 * t15;
-        let o21: f32 = self.pre[29] * o22;
+        let o21: f32 = self.pre[43] * o22;
         let o22: f32 = i2 * o22;
         let o23: f32 = o23 * t15 * t27;
         let t27: f32 = i2 * t18;
@@ -869,8 +1061,8 @@ impl BallWallEuler {
         let o3: f32 = 0f32;
         let o4: f32 = 0f32;
         let o5: f32 = 0f32;
-        let o6: f32 = self.pre[30];
-        let o7: f32 = self.pre[31];
+        let o6: f32 = self.pre[44];
+        let o7: f32 = self.pre[45];
         let o10: f32 = 0f32;
         let o15: f32 = 0f32;
         let o20: f32 = 0f32;
@@ -894,18 +1086,18 @@ impl BallWallEuler {
         let i12: f32 = v[2];
         let i13: f32 = v[3];
         let i14: f32 = v[4];
-        let t0: f32 = self.pre[32];
-        let t8: f32 = self.pre[33];
-        let t4: f32 = self.pre[34];
-        let t1: f32 = self.pre[35];
-        let t2: f32 = self.pre[36];
-        let t3: f32 = self.pre[37];
-        let t5: f32 = self.pre[38];
-        let t6: f32 = self.pre[39];
-        let t7: f32 = self.pre[40];
-        let t9: f32 = self.pre[41];
-        let t10: f32 = self.pre[42];
-        let t11: f32 = self.pre[43];
+        let t0: f32 = self.pre[46];
+        let t8: f32 = self.pre[47];
+        let t4: f32 = self.pre[48];
+        let t1: f32 = self.pre[49];
+        let t2: f32 = self.pre[50];
+        let t3: f32 = self.pre[51];
+        let t5: f32 = self.pre[52];
+        let t6: f32 = self.pre[53];
+        let t7: f32 = self.pre[54];
+        let t9: f32 = self.pre[55];
+        let t10: f32 = self.pre[56];
+        let t11: f32 = self.pre[57];
         let o0: f32 = -(i10);
         let o1: f32 = i11 * t2;
         let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
@@ -923,7 +1115,7 @@ impl BallWallEuler {
         let t21: f32 = i12 + t21;
         let t21: f32 = t1 * t21;
         let o1: f32 = o1 + t18 + t21;
-        let t18: f32 = self.pre[44];
+        let t18: f32 = self.pre[58];
         let t21: f32 = t6 * t15;
         let t22: f32 = t14 * t17;
         let t23: f32 = t7 * t22;
@@ -1007,19 +1199,19 @@ impl BallWallEuler {
         let i22: f32 = dv[2];
         let i23: f32 = dv[3];
         let i24: f32 = dv[4];
-        let t0: f32 = self.pre[45];
-        let t3: f32 = self.pre[46];
-        let t4: f32 = self.pre[47];
-        let t5: f32 = self.pre[48];
-        let t7: f32 = self.pre[49];
-        let t9: f32 = self.pre[50];
-        let t10: f32 = self.pre[51];
-        let t12: f32 = self.pre[52];
-        let t13: f32 = self.pre[53];
-        let t14: f32 = self.pre[54];
-        let t15: f32 = self.pre[55];
-        let t16: f32 = self.pre[56];
-        let t17: f32 = self.pre[57];
+        let t0: f32 = self.pre[59];
+        let t3: f32 = self.pre[60];
+        let t4: f32 = self.pre[61];
+        let t5: f32 = self.pre[62];
+        let t7: f32 = self.pre[63];
+        let t9: f32 = self.pre[64];
+        let t10: f32 = self.pre[65];
+        let t12: f32 = self.pre[66];
+        let t13: f32 = self.pre[67];
+        let t14: f32 = self.pre[68];
+        let t15: f32 = self.pre[69];
+        let t16: f32 = self.pre[70];
+        let t17: f32 = self.pre[71];
         let t18: f32 = -(i10);
         let t19: f32 = -(i20);
         let t20: f32 = i11 * t9;
@@ -1042,7 +1234,7 @@ impl BallWallEuler {
         let t35: f32 = t28 + t33;
         let t36: f32 = t31 + t34;
         let t37: f32 = i14 * t0 * t10 * t35;
-        let t38: f32 = self.pre[58] * t35 * i24;
+        let t38: f32 = self.pre[72] * t35 * i24;
         let t39: f32 = i14 * t0 * t10 * t36;
         let t40: f32 = t38 + t39;
         let t41: f32 = -(t22 * i17);
@@ -1222,6 +1414,229 @@ impl BallWallEuler {
         let o8: f32 = t166;
         let o4: f32 = t206;
         let o9: f32 = t207;
+        ([o0, o1, o2, o3, o4], [o5, o6, o7, o8, o9])
+    }
+    /// Wall `wall`: v⁺ as `collide` computes it, and its derivative along a direction δp of the parameters (in `PARAMETERS` order) at fixed (q, v⁻): (v⁺, ∂v⁺/∂p δp), by forward differentiation of the same program.
+    #[inline]
+    #[allow(unused_variables, clippy::approx_constant)]
+    pub fn wall_collide_parameter_tangent(
+        &self,
+        q: &[f32; 5],
+        v: &[f32; 5],
+        dp: &[f32; 5],
+    ) -> ([f32; 5], [f32; 5]) {
+        let i0: f32 = self.params.m;
+        let i1: f32 = self.params.r;
+        let i2: f32 = self.params.J;
+        let i7: f32 = q[2];
+        let i8: f32 = q[3];
+        let i10: f32 = v[0];
+        let i11: f32 = v[1];
+        let i12: f32 = v[2];
+        let i13: f32 = v[3];
+        let i14: f32 = v[4];
+        let i15: f32 = dp[0];
+        let i16: f32 = dp[1];
+        let i17: f32 = dp[2];
+        let t0: f32 = self.pre[73];
+        let t1: f32 = i2 * i16;
+        let t2: f32 = i1 * i17;
+        let t3: f32 = t1 + t2;
+        let t4: f32 = self.pre[74];
+        let t5: f32 = self.pre[75] * i16;
+        let t7: f32 = t4 * i15;
+        let t8: f32 = i0 * t5;
+        let t9: f32 = t7 + t8;
+        let t10: f32 = self.pre[76];
+        let t11: f32 = 2f32 * i17;
+        let t12: f32 = self.pre[77];
+        let t13: f32 = t9 + t11;
+        let t14: f32 = self.pre[78];
+        let t15: f32 = self.pre[79] * t13;
+        let t17: f32 = t14 * i17;
+        let t18: f32 = i2 * t15;
+        let t19: f32 = t17 + t18;
+        let t20: f32 = self.pre[80];
+        let t21: f32 = self.pre[81] * i16;
+        let t22: f32 = self.pre[82] * t19;
+        let t23: f32 = t21 + t22;
+        let t25: f32 = -4f32 * t19;
+        let t26: f32 = self.pre[83];
+        let t27: f32 = self.pre[84];
+        let t28: f32 = -2f32 * t15;
+        let t29: f32 = self.pre[85];
+        let t30: f32 = i1 * i15;
+        let t31: f32 = i0 * i16;
+        let t32: f32 = t30 + t31;
+        let t33: f32 = self.pre[86];
+        let t34: f32 = -(t32);
+        let t35: f32 = self.pre[87];
+        let t36: f32 = i17 + t9;
+        let t37: f32 = self.pre[88];
+        let t38: f32 = -(i17);
+        let t39: f32 = self.pre[89];
+        let t40: f32 = t29 * t28;
+        let t41: f32 = t27 * t32;
+        let t42: f32 = t40 + t41;
+        let t43: f32 = self.pre[90];
+        let t44: f32 = t27 * i17;
+        let t45: f32 = i2 * t28;
+        let t46: f32 = t44 + t45;
+        let t47: f32 = self.pre[91];
+        let t48: f32 = -2f32 * t32;
+        let t49: f32 = -(i10);
+        let t50: f32 = i11 * t26;
+        let t51: f32 = i11 * t25;
+        let (sc0_sin, sc0_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i7);
+        let t52: f32 = sc0_sin;
+        let (sc1_sin, sc1_cos): (f32, f32) = ::dalembert_runtime::libm::sincosf(i8);
+        let t53: f32 = sc1_sin;
+        let t54: f32 = t52 * t53;
+        let t55: f32 = sc1_cos;
+        let t56: f32 = -(t55);
+        let t57: f32 = t54 + t56;
+        let t58: f32 = i14 * t0 * t27 * t57;
+        let t59: f32 = i14 * t27 * t57 * t3;
+        let t60: f32 = i14 * t0 * t57 * t28;
+        let t61: f32 = t59 + t60;
+        let t62: f32 = sc0_cos;
+        let t63: f32 = i13 * t62;
+        let t64: f32 = -(t63);
+        let t65: f32 = i12 + t64;
+        let t66: f32 = t20 * t65;
+        let t67: f32 = t65 * t23;
+        let t68: f32 = t50 + t58 + t66;
+        let t69: f32 = t51 + t61 + t67;
+        let t70: f32 = t35 * t53;
+        let t71: f32 = t53 * t36;
+        let t72: f32 = t52 * t55;
+        let t73: f32 = t37 * t72;
+        let t74: f32 = t72 * t38;
+        let t75: f32 = t70 + t73;
+        let t76: f32 = t71 + t74;
+        let t77: f32 = 1.0 / (t53);
+        let t78: f32 = t14 * t77;
+        let t79: f32 = t77 * t15;
+        let t80: f32 = -2f32 * t78;
+        let t81: f32 = -2f32 * t79;
+        let t82: f32 = t75 * t80;
+        let t83: f32 = t80 * t76;
+        let t84: f32 = t75 * t81;
+        let t85: f32 = t83 + t84;
+        let t86: f32 = 1f32 + t82;
+        let t87: f32 = i12 * t86;
+        let t88: f32 = i12 * t85;
+        let t89: f32 = t53 + t72;
+        let t90: f32 = t78 * t89;
+        let t91: f32 = t89 * t79;
+        let t92: f32 = i2 * t63 * t90;
+        let t93: f32 = t63 * t90 * i17;
+        let t94: f32 = i2 * t63 * t91;
+        let t95: f32 = t93 + t94;
+        let t96: f32 = i11 * t33 * t90;
+        let t97: f32 = i11 * t90 * t34;
+        let t98: f32 = i11 * t33 * t91;
+        let t99: f32 = t97 + t98;
+        let t100: f32 = t53 * t55;
+        let t101: f32 = t52 + t100;
+        let t102: f32 = t37 * t101;
+        let t103: f32 = t101 * t38;
+        let t104: f32 = t52 * t52;
+        let t105: f32 = i2 * t55;
+        let t106: f32 = t55 * i17;
+        let t107: f32 = t104 * t105;
+        let t108: f32 = t104 * t106;
+        let t109: f32 = t10 * t54;
+        let t110: f32 = t54 * t11;
+        let t111: f32 = t107 + t109;
+        let t112: f32 = t108 + t110;
+        let t113: f32 = t53 * t111;
+        let t114: f32 = t53 * t112;
+        let t115: f32 = t102 + t113;
+        let t116: f32 = t103 + t114;
+        let t117: f32 = i14 * t78 * t115;
+        let t118: f32 = i14 * t115 * t79;
+        let t119: f32 = i14 * t78 * t116;
+        let t120: f32 = t118 + t119;
+        let t121: f32 = t92 + t96 + t117;
+        let t122: f32 = t95 + t99 + t120;
+        let t123: f32 = -2f32 * t121;
+        let t124: f32 = -2f32 * t122;
+        let t125: f32 = t87 + t123;
+        let t126: f32 = t88 + t124;
+        let t127: f32 = i2 * t104;
+        let t128: f32 = t104 * i17;
+        let t129: f32 = t35 + t127;
+        let t130: f32 = t36 + t128;
+        let t131: f32 = i13 * t129;
+        let t132: f32 = i13 * t130;
+        let t133: f32 = t62 * t105;
+        let t134: f32 = t62 * t106;
+        let t135: f32 = t37 * t54 * t62;
+        let t136: f32 = t54 * t62 * t38;
+        let t137: f32 = t133 + t135;
+        let t138: f32 = t134 + t136;
+        let t139: f32 = i14 * t137;
+        let t140: f32 = i14 * t138;
+        let t141: f32 = t131 + t139;
+        let t142: f32 = t132 + t140;
+        let t143: f32 = t27 * t141;
+        let t144: f32 = t141 * t28;
+        let t145: f32 = t27 * t142;
+        let t146: f32 = t144 + t145;
+        let t147: f32 = i11 * t39;
+        let t148: f32 = i11 * t42;
+        let t149: f32 = i12 * t43;
+        let t150: f32 = i12 * t46;
+        let t151: f32 = t147 + t149;
+        let t152: f32 = t148 + t150;
+        let t153: f32 = t62 * t151;
+        let t154: f32 = t62 * t152;
+        let t155: f32 = i13 + t143 + t153;
+        let t156: f32 = t146 + t154;
+        let t157: f32 = t52 * t78;
+        let t158: f32 = t52 * t79;
+        let t159: f32 = i11 * t47 * t157;
+        let t160: f32 = i11 * t157 * t48;
+        let t161: f32 = i11 * t47 * t158;
+        let t162: f32 = t160 + t161;
+        let t163: f32 = i2 * t72;
+        let t164: f32 = t72 * i17;
+        let t165: f32 = t12 * t53;
+        let t166: f32 = t53 * t13;
+        let t167: f32 = t37 * t53 * t104;
+        let t168: f32 = t53 * t104 * t38;
+        let t169: f32 = t163 + t165 + t167;
+        let t170: f32 = t164 + t166 + t168;
+        let t171: f32 = t80 * t169;
+        let t172: f32 = t169 * t81;
+        let t173: f32 = t80 * t170;
+        let t174: f32 = t172 + t173;
+        let t175: f32 = 1f32 + t171;
+        let t176: f32 = i14 * t175;
+        let t177: f32 = i14 * t174;
+        let t178: f32 = -(i12 * t157);
+        let t179: f32 = -(i12 * t158);
+        let t180: f32 = t63 * t157;
+        let t181: f32 = t63 * t158;
+        let t182: f32 = t178 + t180;
+        let t183: f32 = t179 + t181;
+        let t184: f32 = t10 * t182;
+        let t185: f32 = t182 * t11;
+        let t186: f32 = t10 * t183;
+        let t187: f32 = t185 + t186;
+        let t188: f32 = t159 + t176 + t184;
+        let t189: f32 = t162 + t177 + t187;
+        let o0: f32 = t49;
+        let o5: f32 = 0f32;
+        let o1: f32 = t68;
+        let o6: f32 = t69;
+        let o2: f32 = t125;
+        let o7: f32 = t126;
+        let o3: f32 = t155;
+        let o8: f32 = t156;
+        let o4: f32 = t188;
+        let o9: f32 = t189;
         ([o0, o1, o2, o3, o4], [o5, o6, o7, o8, o9])
     }
 }
