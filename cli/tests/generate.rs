@@ -117,6 +117,47 @@ fn tangents_past_the_bound_are_left_out() {
     assert!(!code.contains("accelerations_tangent"));
 }
 
+/// A dense model of 24 coordinates has room for its tangents along the
+/// phase but not for those by the parameters as well: it keeps the first
+/// and its header says the second were left out. (With both counted as
+/// one, it lost both.)
+#[test]
+fn tangents_by_the_parameters_past_the_bound_are_left_out_alone() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("generate");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("dense_24.toml");
+    std::fs::write(&file, dense(24)).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_dalembert"))
+        .arg("generate")
+        .arg(&file)
+        .output()
+        .expect("the CLI runs");
+    let code = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let header = &code[..code.len().min(3000)];
+    assert!(
+        code.contains("//   tangents by the parameters   left out: they would add "),
+        "{header}"
+    );
+    assert!(
+        !code.contains("//   tangents                     left out"),
+        "{header}"
+    );
+    assert!(code.contains("pub fn accelerations_tangent("));
+    assert!(code.contains("pub fn floor_collide_tangent("));
+    for f in [
+        "accelerations_parameter_tangent(",
+        "floor_collide_parameter_tangent(",
+        "floor_surface_parameter_tangent(",
+    ] {
+        assert!(!code.contains(&format!("pub fn {f}")), "{f}");
+    }
+}
+
 /// `derive` of a model written with bodies shows what the bodies layer
 /// derived, each with the line of its declaration, before G.
 #[test]

@@ -50,7 +50,7 @@ pub use symbols::sample_configuration;
 use crate::diag::{Collector, ErrorKind, ModelErrors, Reported};
 use crate::ir::{Kind, Model};
 use crate::program::Program;
-use crate::quantity::Quantity;
+use crate::quantity::{Quantity, Shape};
 
 type Rat = RationalPolynomial<IntegerRing, u16>;
 type Field = RationalPolynomialField<IntegerRing, u16>;
@@ -163,7 +163,8 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
         model.coordinates.len(),
         model.velocities.len(),
     );
-    let tangents_left_out = tangents(&mut functions, &mut walls, dims);
+    let (tangents_left_out, parameter_tangents_left_out) =
+        tangents(&mut functions, &mut walls, dims);
     Ok(Derivation {
         model: model.clone(),
         mass_matrix: strings(&exact.g),
@@ -173,74 +174,91 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
         walls,
         functions,
         tangents_left_out,
+        parameter_tangents_left_out,
         motion_systems,
     })
 }
 
 /// Pass 6: the tangent functions, each placed after the function it
 /// differentiates: q̈'s and each collision map's program differentiated
-/// forward along the phase (the inputs after the `params` parameters) and
-/// along the parameters, and each wall's f along the parameters (what a
-/// collision instant's dependence on them needs). They are about three
-/// times the code of what they differentiate: where they would take the
-/// model past [`crate::MAX_GENERATED_INSTRUCTIONS`] they are left out (the
-/// model then has no derivatives, and its header says why; a model past
-/// the bound without them is refused as before), and the number of
-/// instructions they would have added is returned.
+/// forward along the phase (the inputs after the `params` parameters), then
+/// along the parameters with each wall's f (what a collision instant's
+/// dependence on them needs). Each group is about three times the code of
+/// what it differentiates: where the phase's would take the model past
+/// [`crate::MAX_GENERATED_INSTRUCTIONS`], all are left out (the model then
+/// has no derivatives, and its header says why; a model past the bound
+/// without them is refused as before); where only the parameters' would,
+/// those are. Returns the instructions each left-out case would have added:
+/// (all tangents, the parameters' alone).
 fn tangents(
     functions: &mut Vec<Function>,
     walls: &mut [WallDerivation],
     (params, nq, nv): (usize, usize, usize),
-) -> Option<usize> {
-    // (differentiated, tangent, along the parameters rather than the phase)
-    const MODEL: &[(Quantity, Quantity, bool)] = &[
-        (
-            Quantity::Accelerations,
-            Quantity::AccelerationsTangent,
-            false,
-        ),
-        (
+) -> (Option<usize>, Option<usize>) {
+    // (differentiated, tangent), for the model and for each wall: along
+    // the phase, then along the parameters.
+    type Rows = &'static [(Quantity, Quantity)];
+    const PHASE: (Rows, Rows) = (
+        &[(Quantity::Accelerations, Quantity::AccelerationsTangent)],
+        &[(Quantity::Collide, Quantity::CollideTangent)],
+    );
+    const PARAMETERS: (Rows, Rows) = (
+        &[(
             Quantity::Accelerations,
             Quantity::AccelerationsParameterTangent,
-            true,
-        ),
-    ];
-    const WALL: &[(Quantity, Quantity, bool)] = &[
-        (Quantity::Collide, Quantity::CollideTangent, false),
-        (Quantity::Collide, Quantity::CollideParameterTangent, true),
-        (Quantity::Surface, Quantity::SurfaceParameterTangent, true),
-    ];
-    let tangents = |list: &[Function], rows: &[(Quantity, Quantity, bool)]| -> Vec<Function> {
-        rows.iter()
-            .filter_map(|&(of, quantity, by_parameters)| {
-                let f = list.iter().find(|f| f.quantity == of)?;
-                let source = (f.program).with_inputs(of.spec().inputs.width(params, nq, nv));
-                let program = if by_parameters {
-                    source.tangent_over(0..params)
-                } else {
-                    source.tangent(params)
-                };
-                Some(Function {
-                    quantity,
-                    program,
-                    rows: 0,
+        )],
+        &[
+            (Quantity::Collide, Quantity::CollideParameterTangent),
+            (Quantity::Surface, Quantity::SurfaceParameterTangent),
+        ],
+    );
+    let group = |functions: &[Function], walls: &[WallDerivation], (model, wall): (Rows, Rows)| {
+        let make = |list: &[Function], rows: Rows| -> Vec<Function> {
+            rows.iter()
+                .filter_map(|&(of, quantity)| {
+                    let f = list.iter().find(|f| f.quantity == of)?;
+                    let source = (f.program).with_inputs(of.spec().inputs.width(params, nq, nv));
+                    let program = match quantity {
+                        Quantity::AccelerationsTangent | Quantity::CollideTangent => {
+                            source.tangent(params)
+                        }
+                        _ => source.tangent_over(0..params),
+                    };
+                    Some(Function {
+                        quantity,
+                        program,
+                        rows: 0,
+                    })
                 })
-            })
-            .collect()
+                .collect()
+        };
+        let per_wall: Vec<_> = walls.iter().map(|w| make(&w.functions, wall)).collect();
+        (make(functions, model), per_wall)
     };
-    let model = tangents(functions, MODEL);
-    let per_wall: Vec<_> = walls.iter().map(|w| tangents(&w.functions, WALL)).collect();
     let size = |fs: &[Function]| fs.iter().map(|f| f.program.instrs.len()).sum::<usize>();
+    let total = |(model, walls): &(Vec<Function>, Vec<Vec<Function>>)| {
+        size(model) + walls.iter().map(|fs| size(fs)).sum::<usize>()
+    };
+    let phase = group(functions, walls, PHASE);
+    let by_parameters = group(functions, walls, PARAMETERS);
     let now = size(functions) + walls.iter().map(|w| size(&w.functions)).sum::<usize>();
-    let added = size(&model) + per_wall.iter().map(|fs| size(fs)).sum::<usize>();
-    if now + added > crate::MAX_GENERATED_INSTRUCTIONS {
-        return Some(added);
+    let bound = crate::MAX_GENERATED_INSTRUCTIONS;
+    let (phase_size, parameters_size) = (total(&phase), total(&by_parameters));
+    if now + phase_size > bound {
+        return (Some(phase_size + parameters_size), None);
     }
-    insert_after_sources(functions, model, MODEL);
-    for (w, fs) in walls.iter_mut().zip(per_wall) {
-        insert_after_sources(&mut w.functions, fs, WALL);
+    let mut place = |(model, per_wall): (Vec<Function>, Vec<Vec<Function>>), rows: (Rows, Rows)| {
+        insert_after_sources(functions, model, rows.0);
+        for (w, fs) in walls.iter_mut().zip(per_wall) {
+            insert_after_sources(&mut w.functions, fs, rows.1);
+        }
+    };
+    place(phase, PHASE);
+    if now + phase_size + parameters_size > bound {
+        return (None, Some(parameters_size));
     }
-    None
+    place(by_parameters, PARAMETERS);
+    (None, None)
 }
 
 /// Each tangent placed after the function it differentiates (and after
@@ -248,14 +266,17 @@ fn tangents(
 fn insert_after_sources(
     list: &mut Vec<Function>,
     tangents: Vec<Function>,
-    rows: &[(Quantity, Quantity, bool)],
+    rows: &[(Quantity, Quantity)],
 ) {
+    let is_tangent = |f: &Function| {
+        let spec = f.quantity.spec();
+        matches!(spec.shape, Shape::Tangent | Shape::ScalarTangent)
+    };
     for t in tangents {
         let of = rows.iter().find(|r| r.1 == t.quantity).map(|r| r.0);
         let source = list.iter().position(|f| Some(f.quantity) == of);
         let after = source.map_or(list.len(), |i| {
-            let tangents_of = |f: &Function| rows.iter().any(|r| r.1 == f.quantity);
-            i + 1 + list[i + 1..].iter().take_while(|f| tangents_of(f)).count()
+            i + 1 + list[i + 1..].iter().take_while(|f| is_tangent(f)).count()
         });
         list.insert(after, t);
     }

@@ -28,8 +28,12 @@ pub struct Derivation {
     pub functions: Vec<Function>,
     /// Where the tangent functions were left out (they would have taken
     /// the model's code past [`crate::MAX_GENERATED_INSTRUCTIONS`]): the
-    /// instructions they would have added.
+    /// instructions they would have added. The tangents along the phase
+    /// come first; these count all of them.
     pub tangents_left_out: Option<usize>,
+    /// Where only the tangents by the parameters were left out (the model
+    /// has those along the phase): the instructions they would have added.
+    pub parameter_tangents_left_out: Option<usize>,
     /// Where q̈ is written out by elimination: the system it solves; and
     /// without constraints, closed form or not, G q̈ = −h and the same
     /// motion as the momentum's, for Taylor's method to solve per order.

@@ -127,12 +127,20 @@ fn header(d: &Ctx) -> String {
             "//   {what:<28} structured: solved at run time from G and B\n"
         ));
     }
-    if let Some(added) = d.derivation.tangents_left_out {
-        h.push_str(&format!(
-            "//   {:<28} left out: they would add {added} instructions, past the bound of {}\n",
-            "tangents",
-            crate::MAX_GENERATED_INSTRUCTIONS
-        ));
+    let left_out = [
+        ("tangents", d.derivation.tangents_left_out),
+        (
+            "tangents by the parameters",
+            d.derivation.parameter_tangents_left_out,
+        ),
+    ];
+    for (what, added) in left_out {
+        if let Some(added) = added {
+            h.push_str(&format!(
+                "//   {what:<28} left out: they would add {added} instructions, past the bound of {}\n",
+                crate::MAX_GENERATED_INSTRUCTIONS
+            ));
+        }
     }
     if let Some((motion, walls)) = d.series() {
         h.push_str("//\n// Taylor series, per order (series operations, of them convolutions):\n");
