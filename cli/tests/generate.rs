@@ -88,26 +88,31 @@ fn generated_code_has_a_bounded_size() {
     );
 }
 
-/// A dense model of 30 coordinates is within the bound, but not with its
-/// tangents (about three times q̈'s and the map's code): it generates
-/// without them, and its header says so.
-#[test]
-fn tangents_past_the_bound_are_left_out() {
+/// The code `generate` writes for `dense(n)`, which must succeed.
+fn generated_dense(n: usize) -> String {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("generate");
     std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("dense_30.toml");
-    std::fs::write(&file, dense(30)).unwrap();
+    let file = dir.join(format!("dense_{n}.toml"));
+    std::fs::write(&file, dense(n)).unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_dalembert"))
         .arg("generate")
         .arg(&file)
         .output()
         .expect("the CLI runs");
-    let code = String::from_utf8_lossy(&out.stdout);
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// A dense model of 30 coordinates is within the bound, but not with its
+/// tangents (about three times q̈'s and the map's code): it generates
+/// without them, and its header says so.
+#[test]
+fn tangents_past_the_bound_are_left_out() {
+    let code = generated_dense(30);
     assert!(
         code.contains("//   tangents                     left out: they would add "),
         "{}",
@@ -123,21 +128,7 @@ fn tangents_past_the_bound_are_left_out() {
 /// one, it lost both.)
 #[test]
 fn tangents_by_the_parameters_past_the_bound_are_left_out_alone() {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("generate");
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("dense_24.toml");
-    std::fs::write(&file, dense(24)).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_dalembert"))
-        .arg("generate")
-        .arg(&file)
-        .output()
-        .expect("the CLI runs");
-    let code = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let code = generated_dense(24);
     let header = &code[..code.len().min(3000)];
     assert!(
         code.contains("//   tangents by the parameters   left out: they would add "),
