@@ -7,8 +7,9 @@
 //! - `jacobian`: the whole Jacobian by 2N (resp. Q + N) tangents
 //!   (`accelerations_jacobian`, `collide_jacobian`).
 //!
-//! And §3.2.1's bounce with and without Φ followed
-//! (`simulate::Variational`, `variational` below); its two-bounce return map with
+//! And runs with and without Φ or ∂x/∂p followed (`simulate::Variational`,
+//! `simulate::ParameterSensitivity`, `variational` below); §3.2.1's
+//! two-bounce return map with
 //! and without DΠ (`simulate::return_map`, rtol 1e-12), and the search of
 //! its orbit from the paper's start with ẋ off by 1e-3 (`periodic::find`,
 //! one Newton step at its default tolerance).
@@ -60,39 +61,68 @@ fn one<M: Surfaces<N> + Default, const N: usize>(c: &mut Criterion<ThreadCpuTime
     g.finish();
 }
 
-/// §3.2.1's bounce (`ball_bounce` from its file's start, N = 6) alone and
-/// with Φ followed after every step, or ∂x/∂r (the ball's radius): through 10⁴ bounces by Dormand–Prince
-/// (its default tolerance) and 10³ by RK4 (step 10⁻³), whose steps Φ is
-/// carried through, and through 100 bounces by Taylor's method, along
-/// whose steps Φ is integrated at rtol 1e-10.
+/// Runs from the models' files' starts alone, with Φ followed after every
+/// step, and with ∂x/∂p along one parameter: §3.2.1's bounce
+/// (`ball_bounce`, N = 6; p the ball's radius, which moves the floor and
+/// the map) through 10⁴ bounces by Dormand–Prince (its default tolerance),
+/// 10³ by RK4 (step 10⁻³), whose steps Φ is carried through, and 100 by
+/// Taylor's method, along whose steps Φ is integrated at rtol 1e-10; and
+/// the pendulum at its wall (`pendulum_wall`, N = 2, p the rod's length)
+/// through 10³ collisions by Dormand–Prince. The ball's flight is a
+/// polynomial in time (one Dormand–Prince step resolves it) while its
+/// perturbations are not; the pendulum's flight is not polynomial either.
 fn variational(c: &mut Criterion<ThreadCpuTime>) {
-    use dalembert::models::BallBounce;
-    use dalembert::runtime::simulate::{Integrator, Rk4, Settings, Simulator, State, Taylor};
-    use dalembert::runtime::simulate::{ParameterSensitivity, Variational};
-    let m = BallBounce::default();
+    use dalembert::models::{BallBounce, PendulumWall};
+    use dalembert::runtime::simulate::{Integrator, Rk4, Settings, Taylor};
+    let with = |integrator| Settings {
+        integrator,
+        ..Settings::default()
+    };
+    let ball = BallBounce::default();
+    along_runs(
+        c,
+        &ball,
+        "r",
+        &[
+            ("dormand_prince", Settings::default(), 10_000),
+            ("rk4", with(Integrator::Rk4(Rk4 { step: 1e-3 })), 1_000),
+            ("taylor", with(Integrator::Taylor(Taylor::default())), 100),
+        ],
+    );
+    along_runs(
+        c,
+        &PendulumWall::default(),
+        "l",
+        &[("dormand_prince", Settings::default(), 1_000)],
+    );
+}
+
+/// One model of [`variational`]: for each (method, settings, collisions),
+/// the run alone, with Φ and with ∂x/∂`p`.
+fn along_runs<M: Surfaces<N>, const N: usize>(
+    c: &mut Criterion<ThreadCpuTime>,
+    m: &M,
+    p: &str,
+    methods: &[(&str, dalembert::runtime::simulate::Settings, usize)],
+) {
+    use dalembert::runtime::simulate::{ParameterSensitivity, Simulator, State, Variational};
     let start = State {
         t: 0.0,
         q: m.initial_coordinates(),
         v: m.initial_velocities(),
     };
-    let with = |integrator| Settings {
-        integrator,
-        ..Settings::default()
-    };
-    let methods = [
-        ("dormand_prince", Settings::default(), 10_000),
-        ("rk4", with(Integrator::Rk4(Rk4 { step: 1e-3 })), 1_000),
-        ("taylor", with(Integrator::Taylor(Taylor::default())), 100),
-    ];
-    // ∂/∂r: the radius moves the floor's f and the map.
-    let dp = [0.0, 1.0, 0.0, 0.0];
-    assert_eq!(m.parameter_names()[1], "r");
-    for (name, settings, bounces) in methods {
-        // (follow Φ, follow ∂x/∂r)
+    let k = (m.parameter_names().iter())
+        .position(|name| *name == p)
+        .expect("a parameter of the model");
+    let dp: Vec<f64> = (0..m.parameter_names().len())
+        .map(|i| f64::from(u8::from(i == k)))
+        .collect();
+    for &(name, settings, bounces) in methods {
+        // (follow Φ, follow ∂x/∂p)
         let run = |(phi_on, dp_on): (bool, bool)| {
-            let mut sim = Simulator::new(&m, start, settings).unwrap();
+            let mut sim = Simulator::new(m, start, settings).unwrap();
             let mut phi = Variational::new(1e-10);
-            let mut by_r = ParameterSensitivity::new(&dp, 1e-10);
+            let mut by_p = ParameterSensitivity::new(&dp, 1e-10);
             let mut met = 0;
             while met < bounces {
                 let step = sim.step(f64::INFINITY).unwrap();
@@ -101,10 +131,10 @@ fn variational(c: &mut Criterion<ThreadCpuTime>) {
                     phi.follow(&sim, &step).unwrap();
                 }
                 if dp_on {
-                    by_r.follow(&sim, &step).unwrap();
+                    by_p.follow(&sim, &step).unwrap();
                 }
             }
-            (*sim.state(), *phi.matrix(), by_r.value())
+            (*sim.state(), *phi.matrix(), by_p.value())
         };
         let plain = run((false, false)).0;
         assert_eq!(
@@ -112,12 +142,13 @@ fn variational(c: &mut Criterion<ThreadCpuTime>) {
             run((true, false)).0,
             "following Φ leaves the run alone"
         );
-        assert_eq!(plain, run((false, true)).0, "following ∂x/∂r too");
-        let mut g = c.benchmark_group(format!("variational/ball_bounce_{bounces}_bounces/{name}"));
+        assert_eq!(plain, run((false, true)).0, "following ∂x/∂{p} too");
+        let group = format!("variational/{}_{bounces}_collisions/{name}", m.name());
+        let mut g = c.benchmark_group(group);
         g.sample_size(10);
         g.bench_function("run", |b| b.iter(|| run(black_box((false, false)))));
         g.bench_function("run_and_phi", |b| b.iter(|| run(black_box((true, false)))));
-        g.bench_function("run_and_d_by_r", |b| {
+        g.bench_function(format!("run_and_d_by_{p}"), |b| {
             b.iter(|| run(black_box((false, true))))
         });
         g.finish();

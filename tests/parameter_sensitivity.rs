@@ -2,9 +2,9 @@
 //! (`simulate::ParameterSensitivity`) against finite differences of whole
 //! simulations: s(T) = ∂x(T)/∂p δp against Richardson-extrapolated central
 //! differences of x(T) over runs with the parameters moved along δp, at
-//! rtol 1e-12, through at least 10 collisions, with every integrator (RK4
-//! not on the sleigh, see there). The
-//! start is the same (q₀, v₀) put on each run's constraint manifold
+//! rtol 1e-12, through at least 10 collisions, and each collision's
+//! instant shift ∂t*/∂p δp against the differences of the instants, with
+//! every integrator (RK4 not on the sleigh, see there). The start is the same (q₀, v₀) put on each run's constraint manifold
 //! (h(q) = 0 by Gauss–Newton, v onto ker A(q)), so where the constraints
 //! move with p the start does too: its derivative, by differences of that
 //! algebraic map, is s's starting value. Models: a Chaplygin sleigh whose
@@ -39,32 +39,46 @@ fn moved<M: Model<N, N> + Clone, const N: usize>(m: &M, dp: &[f64], s: f64) -> M
     moved
 }
 
-/// The state at `t_end` from `start`, the collisions on the way, and s
-/// followed along `dp` from `ds0` when asked.
+/// What a run gives: the state at its end, its collision instants, and s
+/// with each collision's ∂t*/∂p δp where it was followed.
+struct Run<const N: usize> {
+    end: State<N>,
+    instants: Vec<f64>,
+    s: Option<(PhasePair<N>, Vec<f64>)>,
+}
+
+/// The run to `t_end` from `start`, s followed along `dp` from `ds0` when
+/// asked.
 fn run<M: Surfaces<N>, const N: usize>(
     m: &M,
     settings: Settings,
     start: ([f64; N], [f64; N]),
     t_end: f64,
     follow: Option<(&[f64], PhasePair<N>)>,
-) -> (State<N>, usize, Option<PhasePair<N>>) {
+) -> Run<N> {
     let (q, v) = start;
     let mut sim = Simulator::new(m, State { t: 0.0, q, v }, settings)
         .unwrap_or_else(|e| panic!("{}: {e:?}", m.name()));
     let mut s =
         follow.map(|(dp, (dq, dv))| ParameterSensitivity::new(dp, 1e-12).starting_at(dq, dv));
-    let mut collisions = 0;
+    let (mut instants, mut shifts) = (Vec::new(), Vec::new());
     while sim.state().t < t_end {
         let step = sim
             .step(t_end)
             .unwrap_or_else(|e| panic!("{}: {e:?}", m.name()));
-        collisions += step.collision.is_some() as usize;
         if let Some(s) = &mut s {
             s.follow(&sim, &step)
                 .unwrap_or_else(|e| panic!("{}: {e:?}", m.name()));
+            assert_eq!(s.collision_shift().is_some(), step.collision.is_some());
+            shifts.extend(s.collision_shift());
         }
+        instants.extend(step.collision.map(|c| c.t));
     }
-    (*sim.state(), collisions, s.map(|s| s.value()))
+    Run {
+        end: *sim.state(),
+        instants,
+        s: s.map(|s| (s.value(), shifts)),
+    }
 }
 
 fn flat<const N: usize>((q, v): &([f64; N], [f64; N])) -> Vec<f64> {
@@ -91,35 +105,42 @@ fn check<M: Surfaces<N> + Clone, const N: usize>(
     for (method, settings, eps, tol) in integrators().into_iter().take(methods) {
         for (what, dp) in directions {
             let ds0 = common::richardson(|s| flat(&start(&moved(m, dp, s))), 1e-4);
-            let (_, collisions, s) = run(m, settings, start(m), t_end, Some((dp, split(&ds0))));
+            let followed = run(m, settings, start(m), t_end, Some((dp, split(&ds0))));
+            let collisions = followed.instants.len();
             assert!(
                 collisions >= 10,
                 "{} ({method}): {collisions} collisions",
                 m.name()
             );
-            let got = flat(&s.unwrap());
+            let (value, shifts) = followed.s.unwrap();
+            // The end state, then the collision instants.
             let at = |s: f64| -> Vec<f64> {
                 let ms = moved(m, dp, s);
-                let (x, c, _) = run(&ms, settings, start(&ms), t_end, None);
+                let r = run(&ms, settings, start(&ms), t_end, None);
                 assert_eq!(
-                    c,
+                    r.instants.len(),
                     collisions,
                     "{} ({method}, {what}): a perturbed run met other walls",
                     m.name()
                 );
-                flat(&(x.q, x.v))
+                let mut x = flat(&(r.end.q, r.end.v));
+                x.extend(r.instants);
+                x
             };
             let fd = common::richardson(at, 2.0 * eps * scale);
-            let (worst, size) = common::relative_gap(&got, &fd);
-            eprintln!(
-                "{} ({method}), ∂/∂{what}: |s − differences| / |differences| = {worst:.1e} (|s| up to {size:.1e}, {collisions} collisions)",
-                m.name()
-            );
-            assert!(
-                worst <= tol,
-                "{} ({method}), ∂/∂{what}: s {got:?}, differences {fd:?}",
-                m.name()
-            );
+            let (fd_x, fd_t) = fd.split_at(2 * N);
+            for (what_of, got, fd) in [("x(T)", &flat(&value)[..], fd_x), ("t*", &shifts, fd_t)] {
+                let (worst, size) = common::relative_gap(got, fd);
+                eprintln!(
+                    "{} ({method}), ∂{what_of}/∂{what}: |s − differences| / |differences| = {worst:.1e} (up to {size:.1e}, {collisions} collisions)",
+                    m.name()
+                );
+                assert!(
+                    worst <= tol,
+                    "{} ({method}), ∂{what_of}/∂{what}: followed {got:?}, differences {fd:?}",
+                    m.name()
+                );
+            }
         }
     }
 }

@@ -169,7 +169,7 @@ fn failure<M: Surfaces<N>, const N: usize>(
         ),
         PeriodicError::Return(ReturnError::Variational(e)) => format!(
             "the return map has no derivative: {}",
-            crate::sim::sensitivity::failure(model, e)
+            crate::sim::sensitivity::failure(model, "Φ", e)
         ),
         PeriodicError::Return(ReturnError::Dynamics(e)) => {
             format!("q̈ at a return could not be computed: {e:?}")

@@ -10,8 +10,8 @@ use dalembert::for_each_model;
 use dalembert::models::*;
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
-    DormandPrince, Integrator, Residual, Rk4, Settings, StartRule, State, Taylor, residual,
-    starting_velocity,
+    DormandPrince, Integrator, Residual, Rk4, Settings, StartRule, State, Taylor, onto_holonomic,
+    residual, starting_velocity,
 };
 use dalembert::runtime::taylor::MAX_ORDER;
 use dalembert_codegen::Derivation;
@@ -264,17 +264,33 @@ pub fn checked_run(args: &RunArgs, flag: &str, span: f64) -> Result<(), String> 
 /// an initial value such as `z = "r"` follows `--set r=1`), then the
 /// coordinates and velocities `--set` names; q on h(q) = 0, and the
 /// velocities neither gives following from A q̇ = 0
-/// ([`starting_velocity`]).
+/// ([`starting_velocity`]). Notes on how the velocities were completed go
+/// to stderr.
 pub fn start<M: Surfaces<N>, const N: usize>(
     set: &[(String, f64)],
     mut model: M,
     derived: &[String],
 ) -> Result<(M, State<N>, Residual), String> {
+    set_parameters(set, &mut model, derived)?;
+    let start = starting_state(set, &model, false)?;
+    if let Some(note) = start.note {
+        eprintln!("note: {note}");
+    }
+    Ok((model, start.state, start.residual))
+}
+
+/// Sets the parameters `set` names on `model`; an error for a name that is
+/// a derived parameter or nothing of the model's.
+fn set_parameters<M: Surfaces<N>, const N: usize>(
+    set: &[(String, f64)],
+    model: &mut M,
+    derived: &[String],
+) -> Result<(), String> {
     let is_state = |m: &M, name: &str| {
         m.coordinate_names().contains(&name) || m.velocity_names().contains(&name)
     };
     for (name, value) in set {
-        if is_state(&model, name) {
+        if is_state(model, name) {
             continue;
         }
         if derived.contains(name) {
@@ -292,6 +308,29 @@ pub fn start<M: Surfaces<N>, const N: usize>(
             ));
         }
     }
+    Ok(())
+}
+
+/// A starting state and what was done to reach it.
+pub struct Start<const N: usize> {
+    pub state: State<N>,
+    /// Its residuals.
+    pub residual: Residual,
+    /// How the velocities were completed or projected, where they were.
+    pub note: Option<String>,
+    /// Whether the coordinates were moved onto h(q) = 0.
+    pub moved: bool,
+}
+
+/// The starting state at `model`'s parameters with the coordinates and
+/// velocities `set` names (see [`start`]). Coordinates off h(q) = 0 are an
+/// error, or with `nearest` moved to the nearest point on it
+/// ([`onto_holonomic`]).
+pub fn starting_state<M: Surfaces<N>, const N: usize>(
+    set: &[(String, f64)],
+    model: &M,
+    nearest: bool,
+) -> Result<Start<N>, String> {
     let mut q = model.initial_coordinates();
     let mut v = model.initial_velocities();
     let mut given = model.initial_velocities_given();
@@ -303,45 +342,54 @@ pub fn start<M: Surfaces<N>, const N: usize>(
             given[i] = true;
         }
     }
-    let position = residual(&model, &q, &v).position;
-    if position > 1e-8 {
+    let mut moved = false;
+    let position = residual(model, &q, &v).position;
+    if position > 1e-8 && nearest {
+        q = onto_holonomic(model, &q).map_err(|e| {
+            format!("the initial coordinates cannot be moved onto the holonomic constraints: {e:?}")
+        })?;
+        moved = true;
+    } else if position > 1e-8 {
         return Err(format!(
             "the initial coordinates violate the holonomic constraints (|h(q)| = {position:e}): set them on the constraint manifold"
         ));
     }
-    let (projected, rule) = starting_velocity(&model, &q, &v, &given).map_err(|e| {
+    let (projected, rule) = starting_velocity(model, &q, &v, &given).map_err(|e| {
         format!("the initial velocity cannot be put on the constraints (A q̇ = 0): {e}")
     })?;
     let names = model.velocity_names();
-    match rule {
+    let note = match rule {
         StartRule::Completed => {
             let followed: Vec<String> = (0..N)
                 .filter(|i| !given[*i] && projected[*i] != 0.0)
                 .map(|i| format!("{} = {:e}", names[i], projected[i]))
                 .collect();
-            if !followed.is_empty() {
-                eprintln!(
-                    "note: the velocities the start does not give follow from the constraints: {}",
+            (!followed.is_empty()).then(|| {
+                format!(
+                    "the velocities the start does not give follow from the constraints: {}",
                     followed.join(", ")
-                );
-            }
+                )
+            })
         }
         StartRule::Projected => {
             let stated: Vec<f64> = (0..N).map(|i| if given[i] { v[i] } else { 0.0 }).collect();
-            eprintln!(
-                "note: the initial velocity {stated:?} is not admissible (A q̇ ≠ 0), and no choice of the velocities it does not give makes it so; using its G-orthogonal projection onto ker A, {projected:?}"
-            );
+            Some(format!(
+                "the initial velocity {stated:?} is not admissible (A q̇ ≠ 0), and no choice of the velocities it does not give makes it so; using its G-orthogonal projection onto ker A, {projected:?}"
+            ))
         }
-    }
+    };
     // The residuals of the state the run starts from (its first row), not
     // of the velocity given before the projection.
-    let start_residual = residual(&model, &q, &projected);
-    let start = State {
-        t: 0.0,
-        q,
-        v: projected,
-    };
-    Ok((model, start, start_residual))
+    Ok(Start {
+        state: State {
+            t: 0.0,
+            q,
+            v: projected,
+        },
+        residual: residual(model, &q, &projected),
+        note,
+        moved,
+    })
 }
 
 /// The simulator's settings from the command line.

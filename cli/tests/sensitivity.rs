@@ -71,6 +71,39 @@ fn through_collisions_the_run_is_the_same_with_and_without() {
     assert_eq!(collisions(&plain), collisions(&followed));
 }
 
+/// A point dropped from height h (its start, `[initial] y = "h"`) onto the
+/// floor under gravity g, written to `dir`.
+fn dropped_point(dir: &str) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let file = PathBuf::from(dir).join("dropped.toml");
+    std::fs::write(
+        &file,
+        "[model]\nname = \"dropped\"\n[parameters]\ng = { value = \"981/100\" }\nh = { value = \"1\" }\n\
+         [coordinates]\nnames = [\"y\"]\n[dynamics]\nkinetic_energy = \"y_dot^2/2\"\n\
+         potential = \"g*y\"\n[[wall]]\nname = \"floor\"\nsurface = \"y\"\n[initial]\ny = \"h\"\n",
+    )
+    .unwrap();
+    file
+}
+
+/// `simulate` of `dropped_point` to t = 3 with `method` and `flags`: its
+/// standard output, and the CSV's header and rows (cells split).
+fn dropped_run(dir: &str, method: &str, flags: &[&str]) -> (String, String, Vec<Vec<String>>) {
+    let file = dropped_point(dir);
+    let mut args = vec!["simulate", file.to_str().unwrap(), "--t-end", "3"];
+    args.extend(["--integrator", method, "--out", dir]);
+    args.extend(flags);
+    let (ok, stdout, stderr) = dalembert(&args);
+    assert!(ok, "{stdout}{stderr}");
+    let csv = std::fs::read_to_string(PathBuf::from(dir).join("dropped.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header = lines.next().unwrap().to_string();
+    let rows = lines
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect();
+    (stdout, header, rows)
+}
+
 /// A point dropped from height y₀ onto the floor under gravity g:
 /// y(t) = v τ − g τ²/2, τ = t − (2m − 1) v/g after m bounces, v = √(2 g y₀).
 /// So ∂y/∂y₀ = (τ − (2m − 1)(v − g τ)/g)·g/v and ∂ẏ/∂y₀ = 2m·g/v: at the
@@ -80,41 +113,16 @@ fn through_collisions_the_run_is_the_same_with_and_without() {
 #[test]
 fn phi_columns_of_a_bouncing_point_follow_its_closed_form() {
     let dir = out_dir("sensitivity_phi_columns");
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = PathBuf::from(&dir).join("bounce_1d.toml");
-    std::fs::write(
-        &file,
-        "[model]\nname = \"bounce_1d\"\n[parameters]\ng = { value = \"981/100\" }\n\
-         [coordinates]\nnames = [\"y\"]\n[dynamics]\nkinetic_energy = \"y_dot^2/2\"\n\
-         potential = \"g*y\"\n[[wall]]\nname = \"floor\"\nsurface = \"y\"\n[initial]\ny = \"1\"\n",
-    )
-    .unwrap();
     let (g, y0) = (9.81f64, 1.0f64);
     let v = (2.0 * g * y0).sqrt();
     for method in ["dormand-prince", "taylor", "rk4"] {
-        let args = [
-            "simulate",
-            file.to_str().unwrap(),
-            "--t-end",
-            "3",
-            "--integrator",
-            method,
-            "--phi",
-            "y/y, y_dot/y",
-            "--out",
-            &dir,
-        ];
-        let (ok, stdout, stderr) = dalembert(&args);
-        assert!(ok, "{stdout}{stderr}");
-        let csv = std::fs::read_to_string(PathBuf::from(&dir).join("bounce_1d.csv")).unwrap();
-        let mut lines = csv.lines();
+        let (_, header, lines) = dropped_run(&dir, method, &["--phi", "y/y, y_dot/y"]);
         assert_eq!(
-            lines.next().unwrap(),
+            header,
             "t,y,y_dot,energy,residual_velocity,residual_position,collision,dy/dy(0),dy_dot/dy(0)"
         );
         let (mut bounces, mut rows) = (0, 0);
-        for line in lines {
-            let cells: Vec<&str> = line.split(',').collect();
+        for cells in &lines {
             let at = |k: usize| cells[k].parse::<f64>().unwrap();
             let (t, dy, dv) = (at(0), at(7), at(8));
             // A bounce's first row is before it, the next after it.
@@ -185,4 +193,229 @@ fn phi_entries_are_named_as_the_model_names_its_state() {
         .map(|k| f64::from(u8::from(k / 4 == k % 4)))
         .collect();
     assert_eq!(first, identity);
+}
+
+/// The height and speed of the point of
+/// [`phi_columns_of_a_bouncing_point_follow_its_closed_form`] dropped from
+/// height `h`, at `t` after `m` bounces.
+fn bounce_closed_form(t: f64, m: u32, g: f64, h: f64) -> [f64; 2] {
+    let v = (2.0 * g * h).sqrt();
+    let tau = t - (2.0 * f64::from(m) - 1.0) * v / g;
+    [v * tau - g * tau * tau / 2.0, v - g * tau]
+}
+
+/// `--by h,g` on the bouncing point dropped from height h (`[initial] y =
+/// "h"`, so the start moves with h and not with g): on every row, with each
+/// method, the columns dy/dp and dy_dot/dp against the closed form's own
+/// derivatives by p at the same t and number of bounces (Richardson
+/// differences of the formula). The row before a bounce has the derivative
+/// of the flight before it, the row after it that of the flight after it.
+#[test]
+fn by_parameters_of_a_bouncing_point_follow_its_closed_form() {
+    let dir = out_dir("sensitivity_by_parameters");
+    let (g, h) = (9.81f64, 1.0f64);
+    let derivative = |f: &dyn Fn(f64) -> [f64; 2], x: f64| -> [f64; 2] {
+        let central = |d: f64| {
+            let (a, b) = (f(x + d), f(x - d));
+            [(a[0] - b[0]) / (2.0 * d), (a[1] - b[1]) / (2.0 * d)]
+        };
+        let (coarse, fine) = (central(1e-4), central(5e-5));
+        [0, 1].map(|i| (4.0 * fine[i] - coarse[i]) / 3.0)
+    };
+    for method in ["dormand-prince", "taylor", "rk4"] {
+        let (stdout, header, lines) = dropped_run(&dir, method, &["--by", "h, g"]);
+        assert!(stdout.contains("  ∂/∂h at t = 3: y "), "{stdout}");
+        assert_eq!(
+            header,
+            "t,y,y_dot,energy,residual_velocity,residual_position,collision,dy/dh,dy_dot/dh,dy/dg,dy_dot/dg"
+        );
+        let (mut bounces, mut rows) = (0, 0);
+        for cells in &lines {
+            let at = |k: usize| cells[k].parse::<f64>().unwrap();
+            let t = at(0);
+            let by_h = derivative(&|h| bounce_closed_form(t, bounces, g, h), h);
+            let by_g = derivative(&|g| bounce_closed_form(t, bounces, g, h), g);
+            for (got, want, what) in [([at(7), at(8)], by_h, "h"), ([at(9), at(10)], by_g, "g")] {
+                for i in 0..2 {
+                    assert!(
+                        (got[i] - want[i]).abs() <= 1e-7 * want[i].abs().max(1.0),
+                        "{method}, t = {t} after {bounces} bounces, ∂/∂{what}: {got:?} against {want:?}"
+                    );
+                }
+            }
+            bounces += u32::from(cells[6] == "floor");
+            rows += 1;
+        }
+        assert_eq!(bounces, 3, "{method}");
+        assert!(rows > 2000, "{method}: {rows} rows");
+    }
+}
+
+/// Richardson-extrapolated central differences of `end` (the end state of
+/// a run with a parameter moved by its argument) at steps 2e-5 and 1e-5.
+fn differences_of_runs(end: impl Fn(f64) -> Vec<f64>) -> Vec<f64> {
+    let central = |d: f64| -> Vec<f64> {
+        let (a, b) = (end(d), end(-d));
+        a.iter().zip(&b).map(|(a, b)| (a - b) / (2.0 * d)).collect()
+    };
+    let (coarse, fine) = (central(2e-5), central(1e-5));
+    fine.iter()
+        .zip(&coarse)
+        .map(|(f, c)| (4.0 * f - c) / 3.0)
+        .collect()
+}
+
+/// `--by` on the hardest kind of model the CLI takes: a Chaplygin sleigh
+/// (a constraint that moves with c, which the start's completed velocity
+/// follows) in an elliptic rink written through a square root (whose edge
+/// moves with a). The end row's columns against Richardson differences of
+/// the end states of whole runs with `--set c=…` or `--set a=…`, through
+/// the same collisions.
+#[test]
+fn by_parameters_on_a_square_root_rink_match_differences_of_whole_runs() {
+    let file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/walls/sleigh_oval.toml"
+    );
+    let dir = out_dir("sensitivity_by_sleigh");
+    let tight = [
+        "--rtol", "1e-12", "--atol", "1e-14", "--t-end", "6", "--every", "0.5",
+    ];
+    // The last row and the number of collisions of a run with `extra`.
+    let run = |extra: &[&str]| -> (Vec<f64>, usize) {
+        let mut args = vec!["simulate", file, "--out", &dir];
+        args.extend(tight);
+        args.extend(extra);
+        let (ok, stdout, stderr) = dalembert(&args);
+        assert!(ok, "{args:?}: {stdout}{stderr}");
+        let collisions = stdout
+            .lines()
+            .find_map(|l| {
+                l.split(" collisions,")
+                    .next()
+                    .filter(|_| l.contains(" collisions,"))
+            })
+            .and_then(|l| l.rsplit(' ').next())
+            .and_then(|n| n.parse().ok())
+            .unwrap_or_else(|| panic!("no collision count in {stdout}"));
+        let csv = std::fs::read_to_string(PathBuf::from(&dir).join("sleigh_oval.csv")).unwrap();
+        let last = csv.lines().last().unwrap();
+        let cells: Vec<f64> = last
+            .split(',')
+            .filter(|c| !c.is_empty())
+            .filter_map(|c| c.parse().ok())
+            .collect();
+        (cells, collisions)
+    };
+    let (followed, collisions) = run(&["--by", "c,a"]);
+    assert!(collisions >= 3, "{collisions} collisions");
+    // t, 3 coordinates, 3 velocities, energy, 2 residuals, then 6 columns
+    // by c and 6 by a.
+    assert_eq!(followed.len(), 10 + 12);
+    for (k, (p, p0)) in [("c", 0.1f64), ("a", 1.2)].into_iter().enumerate() {
+        let end = |d: f64| -> Vec<f64> {
+            let set = format!("{p}={}", p0 + d);
+            let (row, c) = run(&["--set", &set]);
+            assert_eq!(c, collisions, "{p} moved by {d}: other collisions");
+            row[1..7].to_vec()
+        };
+        let want = differences_of_runs(end);
+        let got = &followed[10 + 6 * k..16 + 6 * k];
+        let size = want.iter().fold(1.0f64, |a, x| a.max(x.abs()));
+        for (g, w) in got.iter().zip(&want) {
+            assert!(
+                (g - w).abs() <= 1e-6 * size,
+                "∂/∂{p}: followed {got:?}, differences {want:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn by_names_only_parameters_of_the_model() {
+    let dir = out_dir("sensitivity_by_names");
+    let run = |by: &str| {
+        let args = [
+            "simulate",
+            "pendulum_wall",
+            "--t-end",
+            "0.1",
+            "--by",
+            by,
+            "--out",
+            &dir,
+        ];
+        dalembert(&args)
+    };
+    let (ok, stdout, stderr) = run("x");
+    assert!(!ok, "{stdout}");
+    assert!(
+        stderr.contains("--by: `x` is not a parameter of pendulum_wall (parameters: "),
+        "{stderr}"
+    );
+    let (ok, stdout, stderr) = run("l,l");
+    assert!(!ok, "{stdout}");
+    assert!(stderr.contains("--by: `l` is named twice"), "{stderr}");
+}
+
+/// `--by l` on the built-in pendulum, whose rod length l moves its
+/// holonomic constraint x² + y² = l² away from the file's start: the start
+/// is taken to its nearest point on the circle, l·(−4/5, −3/5), and a note
+/// says so. The end row's columns against differences of whole runs of
+/// the same model with that start written as a function of l in its file
+/// (`--set l=…`), through the same collisions.
+#[test]
+fn by_a_parameter_of_a_holonomic_constraint_moves_the_start_onto_it() {
+    let dir = out_dir("sensitivity_by_rod");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = PathBuf::from(&dir).join("pendulum_wall.toml");
+    let text = include_str!("../../models/pendulum_wall.toml")
+        .replace("x = \"-4/5\"", "x = \"-4/5*l\"")
+        .replace("y = \"-3/5\"", "y = \"-3/5*l\"");
+    assert!(text.contains("-4/5*l") && text.contains("-3/5*l"));
+    std::fs::write(&file, text).unwrap();
+    let tight = [
+        "--rtol", "1e-12", "--atol", "1e-14", "--t-end", "4", "--every", "0.5",
+    ];
+    let run = |model: &str, extra: &[&str]| -> (Vec<f64>, String, String) {
+        let mut args = vec!["simulate", model, "--out", &dir];
+        args.extend(tight);
+        args.extend(extra);
+        let (ok, stdout, stderr) = dalembert(&args);
+        assert!(ok, "{args:?}: {stdout}{stderr}");
+        let csv = std::fs::read_to_string(PathBuf::from(&dir).join("pendulum_wall.csv")).unwrap();
+        let last: Vec<f64> = (csv.lines().last().unwrap().split(','))
+            .filter_map(|c| c.parse().ok())
+            .collect();
+        let collisions = stdout
+            .lines()
+            .find(|l| l.contains(" collisions,"))
+            .unwrap()
+            .split(" steps")
+            .next()
+            .unwrap()
+            .to_string();
+        (last, collisions, stderr)
+    };
+    let (followed, collisions, stderr) = run("pendulum_wall", &["--by", "l"]);
+    assert!(
+        stderr.contains("note: --by l: the start's coordinates leave the holonomic constraints"),
+        "{stderr}"
+    );
+    let end = |d: f64| -> Vec<f64> {
+        let set = format!("l={}", 1.0 + d);
+        let (row, c, _) = run(file.to_str().unwrap(), &["--set", &set]);
+        assert_eq!(c, collisions, "l moved by {d}: other collisions");
+        row[1..5].to_vec()
+    };
+    let want = differences_of_runs(end);
+    // t, 2 coordinates, 2 velocities, energy, 2 residuals, then 4 columns.
+    let got = &followed[8..12];
+    let size = want.iter().fold(1.0f64, |a, x| a.max(x.abs()));
+    for (g, w) in got.iter().zip(&want) {
+        assert!(
+            (g - w).abs() <= 1e-6 * size,
+            "∂/∂l: followed {got:?}, differences {want:?}"
+        );
+    }
 }

@@ -8,8 +8,7 @@ use std::time::Instant;
 
 use clap::Args;
 use dalembert::runtime::prelude::*;
-use dalembert::runtime::saltation::StateMatrix;
-use dalembert::runtime::simulate::{SimError, Simulator, Variational};
+use dalembert::runtime::simulate::{SimError, Simulator};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::plot::plot;
@@ -19,7 +18,7 @@ mod output;
 pub(crate) mod sensitivity;
 pub use output::Row;
 use output::{MAX_ROWS, Output};
-use sensitivity::Columns;
+use sensitivity::{Columns, Followed, by_parameters};
 
 #[derive(Args, Debug)]
 pub struct SimulateArgs {
@@ -55,6 +54,15 @@ pub struct SimulateArgs {
     /// a collision has Φ just before it, the row after it Φ after it.
     #[arg(long)]
     pub phi: Option<String>,
+    /// Parameters to differentiate the run by, separated by commas (e.g.
+    /// `r,g`): for each parameter p, ∂A/∂p at t for every coordinate and
+    /// velocity A is added to the CSV as a column `dA/dp`, and its values
+    /// at the end to the summary. Followed through the collisions as Φ is
+    /// (at `--rtol`), with the start's own derivative (its `[initial]`
+    /// may depend on p) by differences. Every row is then a step's end;
+    /// the row just before a collision has the derivative just before it.
+    #[arg(long)]
+    pub by: Option<String>,
 }
 
 /// Runs `dalembert simulate`.
@@ -100,7 +108,11 @@ fn run<M: Surfaces<N>, const N: usize>(
 ) -> Result<bool, String> {
     let every = checked_spacing(args)?;
     let path = path_axes(&model, args.path.as_deref())?;
-    let (model, start, start_residual) = start(&args.run.set, model, derived)?;
+    let (mut model, start, start_residual) = start(&args.run.set, model, derived)?;
+    let by = (args.by.as_deref())
+        .map(|spec| by_parameters(&mut model, &args.run.set, derived, spec))
+        .transpose()?
+        .unwrap_or_default();
     let e0 = model.energy(&start.q, &start.v);
     if !e0.is_finite() {
         return Err(format!(
@@ -116,10 +128,8 @@ fn run<M: Surfaces<N>, const N: usize>(
     let columns = (args.phi.as_deref())
         .map(|spec| Columns::parse(&model, spec))
         .transpose()?;
-    let names = columns.as_ref().map_or(&[][..], |c| &c.names[..]);
-    let mut out = Output::<N>::create(&model, &csv, e0, names)?;
-    let mut phi = (args.sensitivity || columns.is_some()).then(|| Variational::new(args.run.rtol));
-    let entries = |m: &StateMatrix<N>| columns.as_ref().map_or(Vec::new(), |c| c.values(m));
+    let mut followed = Followed::new(&model, (args.sensitivity, columns), &by, args.run.rtol);
+    let mut out = Output::<N>::create(&model, &csv, e0, &followed.names)?;
     out.push(
         Row {
             t: 0.0,
@@ -129,7 +139,7 @@ fn run<M: Surfaces<N>, const N: usize>(
             residual: [start_residual.velocity, start_residual.position],
             event: None,
         },
-        &entries(&StateMatrix::identity()),
+        &followed.values(false),
     )?;
     // The output's bound, before a run that may be long.
     println!(
@@ -142,23 +152,21 @@ fn run<M: Surfaces<N>, const N: usize>(
         (args.t_end / every * (1.0 - 1e-12)).ceil() as u64 + 1
     );
     let clock = Instant::now();
-    // Φ is known at the steps' ends only.
-    let dense = matches!(args.run.integrator, Method::Taylor) && columns.is_none();
+    // Φ and the derivatives by parameters are known at the steps' ends
+    // only.
+    let dense = matches!(args.run.integrator, Method::Taylor) && !followed.writes_columns();
     let failure = integrate(
         &mut sim,
         &model,
         (args.t_end, every, dense),
         &mut out,
-        phi.as_mut(),
-        &entries,
+        &mut followed,
     )?;
     let elapsed = clock.elapsed();
     out.finish()?;
     plot(&svg, &model, &out.kept, path, e0)?;
     summary(&sim, &model, args, &out, e0, elapsed.as_secs_f64());
-    if let Some(phi) = &phi {
-        sensitivity::report(&model, &start, sim.state().t, phi)?;
-    }
+    followed.report(&model, &start, sim.state().t)?;
     println!("  trajectory: {} ({} rows)", csv.display(), out.written);
     println!("  plot:       {}", svg.display());
     match failure {
@@ -183,8 +191,7 @@ fn integrate<'m, M: Surfaces<N>, const N: usize>(
     model: &'m M,
     (t_end, every, dense): (f64, f64, bool),
     out: &mut Output<'m, N>,
-    mut phi: Option<&mut Variational<N>>,
-    entries: &dyn Fn(&StateMatrix<N>) -> Vec<f64>,
+    followed: &mut Followed<'_, N>,
 ) -> Result<Option<String>, String> {
     let bar = ProgressBar::new(1000);
     bar.set_style(
@@ -207,10 +214,8 @@ fn integrate<'m, M: Surfaces<N>, const N: usize>(
                 break;
             }
         };
-        if let Some(phi) = phi.as_deref_mut()
-            && let Err(e) = phi.follow(sim, &step)
-        {
-            failure = Some(sensitivity::failure(model, e));
+        if let Err(e) = followed.follow(model, sim, &step) {
+            failure = Some(e);
             break;
         }
         // Rows strictly inside the step (before its collision, if any);
@@ -220,16 +225,11 @@ fn integrate<'m, M: Surfaces<N>, const N: usize>(
             let Some(s) = sim.state_at(grid(k)) else {
                 break;
             };
-            // (Only where Φ is not written: rows inside steps are dense.)
+            // (Only where no derivatives are written: rows inside steps
+            // are dense.)
             out.push(Row::of(model, s.t, s.q, s.v), &[])?;
             k += 1.0;
         }
-        let phi_now = phi
-            .as_deref()
-            .map(|p| (entries(p.before_collision()), entries(p.matrix())));
-        let (before, after) = phi_now
-            .as_ref()
-            .map_or((&[][..], &[][..]), |(b, a)| (&b[..], &a[..]));
         if let Some(c) = &step.collision {
             // The state just before the collision, from its record.
             out.push(
@@ -237,7 +237,7 @@ fn integrate<'m, M: Surfaces<N>, const N: usize>(
                     event: Some(model.wall_name(c.wall)),
                     ..Row::of(model, c.t, c.q, c.v_minus)
                 },
-                before,
+                &followed.values(true),
             )?;
         }
         let s = &step.state;
@@ -247,7 +247,7 @@ fn integrate<'m, M: Surfaces<N>, const N: usize>(
         }
         let on_grid = s.t >= grid(k);
         if on_grid || step.collision.is_some() || failure.is_some() {
-            out.push(Row::of(model, s.t, s.q, s.v), after)?;
+            out.push(Row::of(model, s.t, s.q, s.v), &followed.values(false))?;
         }
         if failure.is_some() {
             break;

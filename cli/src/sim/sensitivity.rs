@@ -1,14 +1,224 @@
-//! `simulate --sensitivity` and `--phi`: Φ = ∂x(t)/∂x(0) followed through
-//! the run (`simulate::Variational`), why it could not follow a step, the
-//! growth the summary reports, and the entries written to the CSV.
+//! `simulate --sensitivity`, `--phi` and `--by`: Φ = ∂x(t)/∂x(0) and
+//! ∂x(t)/∂p followed through the run (`simulate::Variational`,
+//! `simulate::ParameterSensitivity`), why they could not follow a step,
+//! what the summary reports, and the columns written to the CSV.
 
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::saltation::StateMatrix;
-use dalembert::runtime::simulate::{State, Variational, VariationalError, tangent_direction};
+use dalembert::runtime::simulate::{
+    ParameterSensitivity, Simulator, State, Step, Variational, VariationalError, tangent_direction,
+};
 
-/// Why Φ could not follow the run, naming walls as the model file does.
+use crate::run::starting_state;
+
+/// What a run follows besides its state, and the CSV columns that adds:
+/// Φ (`--sensitivity`, `--phi`, whose entries are columns) and the
+/// derivatives by the parameters `--by` names (2N columns each).
+pub(super) struct Followed<'p, const N: usize> {
+    pub(super) phi: Option<Variational<N>>,
+    columns: Option<Columns>,
+    /// The parameters' names, with their derivatives.
+    by: Vec<(&'p str, ParameterSensitivity<'p, N>)>,
+    /// The added columns' headers.
+    pub(super) names: Vec<String>,
+}
+
+impl<'p, const N: usize> Followed<'p, N> {
+    /// Φ when `phi` (its entries `columns` written), and one derivative
+    /// for each of `by`: a parameter's name, its unit direction and the
+    /// start's derivative along it; `rtol` as for [`Variational::new`].
+    pub(super) fn new<M: Surfaces<N>>(
+        model: &M,
+        (phi, columns): (bool, Option<Columns>),
+        by: &'p [ByParameter<N>],
+        rtol: f64,
+    ) -> Self {
+        let mut names = columns.as_ref().map_or(Vec::new(), |c| c.names.clone());
+        let state_names: Vec<&str> = (model.coordinate_names().iter())
+            .chain(model.velocity_names())
+            .copied()
+            .collect();
+        for p in by {
+            names.extend(state_names.iter().map(|a| format!("d{a}/d{}", p.name)));
+        }
+        Self {
+            phi: (phi || columns.is_some()).then(|| Variational::new(rtol)),
+            columns,
+            by: by
+                .iter()
+                .map(|p| {
+                    let (dq, dv) = p.start;
+                    let s = ParameterSensitivity::new(&p.direction, rtol).starting_at(dq, dv);
+                    (p.name.as_str(), s)
+                })
+                .collect(),
+            names,
+        }
+    }
+
+    /// Whether the CSV has columns of ours (whose rows must be steps' ends).
+    pub(super) fn writes_columns(&self) -> bool {
+        !self.names.is_empty()
+    }
+
+    /// Follows `step`, the step `sim` has just made; why not, naming walls
+    /// as the model file does.
+    pub(super) fn follow<M: Surfaces<N>>(
+        &mut self,
+        model: &M,
+        sim: &Simulator<'_, M, N>,
+        step: &Step<M::Wall, N>,
+    ) -> Result<(), String> {
+        if let Some(phi) = &mut self.phi {
+            phi.follow(sim, step).map_err(|e| failure(model, "Φ", e))?;
+        }
+        for (p, s) in &mut self.by {
+            (s.follow(sim, step)).map_err(|e| failure(model, &format!("∂x/∂{p}"), e))?;
+        }
+        Ok(())
+    }
+
+    /// The columns' values now, or just before the last step's collision.
+    pub(super) fn values(&self, before: bool) -> Vec<f64> {
+        let mut out = Vec::with_capacity(self.names.len());
+        if let (Some(columns), Some(phi)) = (&self.columns, &self.phi) {
+            let m = if before {
+                phi.before_collision()
+            } else {
+                phi.matrix()
+            };
+            out.extend(columns.values(m));
+        }
+        for (_, s) in &self.by {
+            let (dq, dv) = if before {
+                s.before_collision()
+            } else {
+                s.value()
+            };
+            out.extend(dq.iter().chain(&dv));
+        }
+        out
+    }
+
+    /// The summary's lines: Φ's growth, and each derivative by a
+    /// parameter at the end.
+    pub(super) fn report<M: Surfaces<N>>(
+        &self,
+        model: &M,
+        start: &State<N>,
+        t: f64,
+    ) -> Result<(), String> {
+        if let Some(phi) = &self.phi {
+            report(model, start, t, phi)?;
+        }
+        let names: Vec<&str> = (model.coordinate_names().iter())
+            .chain(model.velocity_names())
+            .copied()
+            .collect();
+        for (p, s) in &self.by {
+            let (dq, dv) = s.value();
+            let values: Vec<String> = (names.iter().zip(dq.iter().chain(&dv)))
+                .map(|(a, d)| format!("{a} {d:.6e}"))
+                .collect();
+            println!("  ∂/∂{p} at t = {t}: {}", values.join(", "));
+        }
+        Ok(())
+    }
+}
+
+/// A parameter the run is differentiated by (`--by`).
+pub(super) struct ByParameter<const N: usize> {
+    name: String,
+    /// Its unit direction among the model's parameters.
+    direction: Vec<f64>,
+    /// The start's derivative by it, (∂q₀/∂p, ∂q̇₀/∂p).
+    start: ([f64; N], [f64; N]),
+}
+
+/// For each parameter `spec` names (`--by`, names separated by commas):
+/// its name, its unit direction, and the derivative along it of the start
+/// `set` gives ([`starting_state`], whose `[initial]` may depend on the
+/// parameters; coordinates that leave h(q) = 0 as p moves are taken to
+/// their nearest point on it, and a note says so), by
+/// Richardson-extrapolated central differences with the parameter moved by
+/// 10⁻³ max(1, |p|) and half that; `model` is left as it came.
+pub(super) fn by_parameters<M: Surfaces<N>, const N: usize>(
+    model: &mut M,
+    set: &[(String, f64)],
+    derived: &[String],
+    spec: &str,
+) -> Result<Vec<ByParameter<N>>, String> {
+    let all: Vec<String> = model
+        .parameter_names()
+        .iter()
+        .map(|p| p.to_string())
+        .collect();
+    let mut out = Vec::new();
+    for name in spec.split(',').map(str::trim) {
+        let Some(k) = all.iter().position(|p| p == name) else {
+            let why = if derived.iter().any(|d| d == name) {
+                "a derived parameter (computed from others): differentiate by those"
+            } else {
+                "not a parameter"
+            };
+            return Err(format!(
+                "--by: `{name}` is {why} of {} (parameters: {})",
+                model.name(),
+                all.join(", ")
+            ));
+        };
+        if out.iter().any(|p: &ByParameter<N>| p.name == name) {
+            return Err(format!("--by: `{name}` is named twice"));
+        }
+        let p0 = model.parameter(k).expect("a parameter of the model's list");
+        let mut moved = false;
+        let mut at = |p: f64| -> Result<Vec<f64>, String> {
+            model.set_parameter(k, p);
+            let start = starting_state(set, &*model, true)
+                .map_err(|e| format!("--by {name}: with {name} = {p}, {e}"))?;
+            moved |= start.moved;
+            let x = start.state;
+            Ok(x.q.iter().chain(&x.v).copied().collect())
+        };
+        let h = 1e-3 * p0.abs().max(1.0);
+        let mut central = |h: f64| -> Result<Vec<f64>, String> {
+            let (plus, minus) = (at(p0 + h)?, at(p0 - h)?);
+            Ok((plus.iter().zip(&minus))
+                .map(|(a, b)| (a - b) / (2.0 * h))
+                .collect())
+        };
+        let derivative = central(h).and_then(|coarse| {
+            let fine = central(h / 2.0)?;
+            Ok((fine.iter().zip(&coarse))
+                .map(|(f, c)| (4.0 * f - c) / 3.0)
+                .collect::<Vec<f64>>())
+        });
+        model.set_parameter(k, p0);
+        let d = derivative?;
+        if moved {
+            eprintln!(
+                "note: --by {name}: the start's coordinates leave the holonomic constraints h(q) = 0 as {name} moves; the start's derivative is that of their nearest point on them (in the metric of G)"
+            );
+        }
+        out.push(ByParameter {
+            name: name.to_string(),
+            direction: (0..all.len())
+                .map(|i| f64::from(u8::from(i == k)))
+                .collect(),
+            start: (
+                core::array::from_fn(|i| d[i]),
+                core::array::from_fn(|i| d[N + i]),
+            ),
+        });
+    }
+    Ok(out)
+}
+
+/// Why `what` (Φ, or a derivative by a parameter) could not follow the
+/// run, naming walls as the model file does.
 pub(crate) fn failure<M: Surfaces<N>, const N: usize>(
     model: &M,
+    what: &str,
     e: VariationalError<M::Wall>,
 ) -> String {
     let e = match e {
@@ -21,12 +231,12 @@ pub(crate) fn failure<M: Surfaces<N>, const N: usize>(
         }
         other => format!("{other:?}"),
     };
-    format!("Φ could not follow the run: {e}")
+    format!("{what} could not follow the run: {e}")
 }
 
 /// The growth of the perturbation of every coordinate and velocity by the
 /// same amount, moved onto the admissible directions at the start.
-pub(super) fn report<M: Surfaces<N>, const N: usize>(
+fn report<M: Surfaces<N>, const N: usize>(
     model: &M,
     start: &State<N>,
     t: f64,

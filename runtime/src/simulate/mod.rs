@@ -74,7 +74,9 @@ mod types;
 mod variational;
 
 pub use integrator::{DormandPrince, Integrator, Rk4, Taylor};
-pub use projection::{StartRule, admissible, residual, starting_velocity, tangent_direction};
+pub use projection::{
+    StartRule, admissible, onto_holonomic, residual, starting_velocity, tangent_direction,
+};
 pub use return_map::{Return, ReturnError, Section, return_map};
 pub use types::{Collision, Residual, Settings, SimError, State, Stats, Step};
 pub use variational::{ParameterSensitivity, Variational, VariationalError};

@@ -18,41 +18,17 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         let m = self.model;
         let t = self.state.t;
         let fail = |error| SimError::Projection { t, error };
-        let mut moved = false;
-        let holonomic = m.holonomic(&self.state.q);
-        if !holonomic.as_slice().is_empty() {
-            let mut q = self.state.q;
-            let mut r = holonomic;
-            let mut done = false;
-            for _ in 0..HOLONOMIC_STEPS {
-                if r.max_abs() <= HOLONOMIC_DONE_ULPS * f64::EPSILON * (1.0 + norm(&q)) {
-                    done = true;
-                    break;
-                }
-                let g = m.mass_matrix(&q);
-                let a = m.constraints(&q);
-                let rows = &a.as_slice()[..r.as_slice().len()];
-                let d = linalg::correction(&g, rows, r.as_slice()).map_err(fail)?;
-                for (qi, di) in q.iter_mut().zip(d) {
-                    *qi -= di;
-                }
-                r = m.holonomic(&q);
-                moved = true;
-            }
-            if !done && r.max_abs() > HOLONOMIC_FAILED * (1.0 + norm(&q)) {
-                return Err(fail(ProjectorError::DependentRows));
-            }
-            self.state.q = q;
-        }
+        // (h's rows are A's first: where q moves, A is not empty.)
+        self.state.q = onto_holonomic(m, &self.state.q).map_err(fail)?;
         let a = m.constraints(&self.state.q);
-        if !a.is_empty() {
+        let moved = !a.is_empty();
+        if moved {
             let g = m.mass_matrix(&self.state.q);
             let r = a.apply(&self.state.v);
             let d = linalg::correction(&g, a.as_slice(), r.as_slice()).map_err(fail)?;
             for (vi, di) in self.state.v.iter_mut().zip(d) {
                 *vi -= di;
             }
-            moved = true;
         }
         // Taylor's method starts every step from the state itself.
         if moved && matches!(self.engine, Engine::RungeKutta(_)) {
@@ -64,6 +40,39 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         }
         Ok(())
     }
+}
+
+/// q moved onto h(q) = 0 by Gauss–Newton in the metric of G (each step the
+/// G-smallest correction that zeroes the linearised residual): the nearest
+/// point of the constraint manifold to a q near it. q itself, to rounding,
+/// where it is on h = 0 or the model has no holonomic constraint. An error
+/// where the rows are dependent or the iteration leaves h far from zero.
+pub fn onto_holonomic<M: Dynamics<N>, const N: usize>(
+    m: &M,
+    q: &[f64; N],
+) -> Result<[f64; N], ProjectorError> {
+    let mut q = *q;
+    let mut r = m.holonomic(&q);
+    if r.as_slice().is_empty() {
+        return Ok(q);
+    }
+    for _ in 0..HOLONOMIC_STEPS {
+        if r.max_abs() <= HOLONOMIC_DONE_ULPS * f64::EPSILON * (1.0 + norm(&q)) {
+            return Ok(q);
+        }
+        let g = m.mass_matrix(&q);
+        let a = m.constraints(&q);
+        let rows = &a.as_slice()[..r.as_slice().len()];
+        let d = linalg::correction(&g, rows, r.as_slice())?;
+        for (qi, di) in q.iter_mut().zip(d) {
+            *qi -= di;
+        }
+        r = m.holonomic(&q);
+    }
+    if r.max_abs() > HOLONOMIC_FAILED * (1.0 + norm(&q)) {
+        return Err(ProjectorError::DependentRows);
+    }
+    Ok(q)
 }
 
 /// Constraint residuals of model `m` at (q, v).

@@ -204,6 +204,8 @@ pub struct ParameterSensitivity<'p, const N: usize> {
     dp: &'p [f64],
     s: Phase<N>,
     before: Phase<N>,
+    /// ∂t*/∂p δp of the last step's collision.
+    shift: Option<f64>,
     method: DormandPrince,
     h: f64,
 }
@@ -217,6 +219,7 @@ impl<'p, const N: usize> ParameterSensitivity<'p, N> {
             dp,
             s: Phase::ZERO,
             before: Phase::ZERO,
+            shift: None,
             method: v.method,
             h: v.h,
         }
@@ -241,6 +244,14 @@ impl<'p, const N: usize> ParameterSensitivity<'p, N> {
         (self.before.q, self.before.v)
     }
 
+    /// How the last step's collision instant t* moves along δp,
+    /// ∂t*/∂p δp = ∂t*/∂q · δq⁻ + the jump's own shift
+    /// ([`crate::saltation::ParameterJump::dt`]); `None` when the step met
+    /// no wall.
+    pub fn collision_shift(&self) -> Option<f64> {
+        self.shift
+    }
+
     /// Advances s over `step`, the step `sim` has just made: along its
     /// motion, then through its collision if it ended at one.
     pub fn follow<M: Surfaces<N>>(
@@ -254,6 +265,7 @@ impl<'p, const N: usize> ParameterSensitivity<'p, N> {
             self.s = flight.carry(self.s, derivative, self.method, &mut self.h)?;
         }
         self.before = self.s;
+        self.shift = None;
         if let Some(c) = &step.collision {
             let model = sim.model();
             let error = |error| VariationalError::Saltation {
@@ -262,6 +274,8 @@ impl<'p, const N: usize> ParameterSensitivity<'p, N> {
             };
             let salt = saltation(model, c.wall, &c.q, &c.v_minus).map_err(error)?;
             let jump = parameter_jump(model, c.wall, &c.q, &c.v_minus, self.dp).map_err(error)?;
+            let by_q: f64 = salt.dt_dq.iter().zip(&self.s.q).map(|(a, b)| a * b).sum();
+            self.shift = Some(by_q + jump.dt);
             let (q, v) = salt.matrix.apply(&self.s.q, &self.s.v);
             self.s = Phase {
                 q: core::array::from_fn(|i| q[i] + jump.dx.0[i]),
