@@ -356,6 +356,20 @@ fn by_names_only_parameters_of_the_model() {
     let (ok, stdout, stderr) = run("l,l");
     assert!(!ok, "{stdout}");
     assert!(stderr.contains("--by: `l` is named twice"), "{stderr}");
+    // A derived parameter (the coin's A = m R²/4) is not a direction of
+    // its own.
+    let coin = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/bodies/coin.toml");
+    let args = [
+        "simulate", coin, "--t-end", "0.1", "--by", "A", "--out", &dir,
+    ];
+    let (ok, stdout, stderr) = dalembert(&args);
+    assert!(!ok, "{stdout}");
+    assert!(
+        stderr.contains(
+            "--by: `A` is a derived parameter of coin (computed from others): differentiate by those it is computed from (parameters: m, R, g)"
+        ),
+        "{stderr}"
+    );
 }
 
 /// `--by l` on the built-in pendulum, whose rod length l moves its

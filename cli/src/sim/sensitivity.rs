@@ -156,16 +156,15 @@ pub(super) fn by_parameters<M: Surfaces<N>, const N: usize>(
     let mut out = Vec::new();
     for name in spec.split(',').map(str::trim) {
         let Some(k) = all.iter().position(|p| p == name) else {
-            let why = if derived.iter().any(|d| d == name) {
-                "a derived parameter (computed from others): differentiate by those"
+            let model_name = model.name();
+            let list = all.join(", ");
+            return Err(if derived.iter().any(|d| d == name) {
+                format!(
+                    "--by: `{name}` is a derived parameter of {model_name} (computed from others): differentiate by those it is computed from (parameters: {list})"
+                )
             } else {
-                "not a parameter"
-            };
-            return Err(format!(
-                "--by: `{name}` is {why} of {} (parameters: {})",
-                model.name(),
-                all.join(", ")
-            ));
+                format!("--by: `{name}` is not a parameter of {model_name} (parameters: {list})")
+            });
         };
         if out.iter().any(|p: &ByParameter<N>| p.name == name) {
             return Err(format!("--by: `{name}` is named twice"));
