@@ -120,6 +120,15 @@ pub mod prelude {
 pub mod __private {
     pub use crate::linalg::{correction, projector};
     pub use libm;
+
+    /// The Taylor recurrences generated series code is made of, and the
+    /// buffers it works on.
+    pub mod taylor {
+        pub use crate::taylor::pair::{Pair, Pairs};
+        pub use crate::taylor::recurrences::*;
+        pub use crate::taylor::solve::{ldl_factor, ldl_solve, lower};
+        pub use crate::taylor::{CAPACITY, Coefficients, MAX_ORDER, Series, Work};
+    }
 }
 
 /// The math functions generated code uses (libm, `no_std`).

@@ -274,7 +274,7 @@ pub trait Dynamics<const N: usize>: Model<N, N> {
     /// ([`Dynamics::taylor_series`], [`Surfaces::surface_series`]), kept by
     /// the caller from one call to the next, so that a call neither zeroes
     /// its intermediate arrays nor holds them on its stack (`chain_8`'s are
-    /// 22 KiB, and 64.5 KiB of [`crate::taylor::Pairs`], the coefficients
+    /// 22 KiB, and 64.5 KiB of coefficient pairs, which
     /// its history loops read two at a time). A generated model's is its
     /// module's `SeriesScratch`; `()`
     /// where a model keeps none. `Default` gives room ready for any call;

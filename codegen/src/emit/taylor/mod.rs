@@ -5,7 +5,7 @@
 //! written out as one loop over the orders. Order 0 is the program on the
 //! values; at each order k ≥ 1 one inner loop over j = 1..k−1 sums every
 //! convolution's history side by side, then each operation is finished in
-//! program order (`dalembert_runtime::taylor`'s `*_finish`). f64 only (the
+//! program order (`dalembert_runtime::__private::taylor`'s `*_finish`). f64 only (the
 //! runtime's series are f64).
 
 //!
@@ -108,7 +108,7 @@ pub(super) fn functions(d: &Ctx) -> TokenStream {
             #motion_prelude
             for k in 0..order {
                 #motion_ops
-                let ik = ::dalembert_runtime::taylor::RECIPROCALS[k + 1];
+                let ik = ::dalembert_runtime::__private::taylor::RECIPROCALS[k + 1];
                 #(#feedback)*
             }
             s.order = order;
@@ -194,7 +194,7 @@ fn momentum_series(
                     break;
                 }
                 #after
-                let ik = ::dalembert_runtime::taylor::RECIPROCALS[k + 1];
+                let ik = ::dalembert_runtime::__private::taylor::RECIPROCALS[k + 1];
                 #(#feedback)*
             }
             s.order = order;

@@ -153,7 +153,7 @@ pub(super) fn order_factor(op: &Op) -> bool {
 
 /// Order 0: each function's value (the runtime's recurrences at order 0).
 fn order_zero(d: &Ctx, t: &Transform, range: Range<usize>, solve: Option<&Solve>) -> TokenStream {
-    let tay = quote! { ::dalembert_runtime::taylor };
+    let tay = quote! { ::dalembert_runtime::__private::taylor };
     let first = range.start;
     let stmts = t.ops[range].iter().enumerate().map(|(i, op)| {
         if let Some(l) = linear(d, &t.numbers, op, At::Zero) {
@@ -285,7 +285,7 @@ fn store_x(solve: &Solve) -> TokenStream {
 /// at most [`SUMS_PER_LOOP`] running sums per loop), then each op's finish
 /// in program order, then the group's lanes at order k.
 fn order_k(d: &Ctx, t: &Transform, plan: &GroupPlan) -> (TokenStream, TokenStream) {
-    let tay = quote! { ::dalembert_runtime::taylor };
+    let tay = quote! { ::dalembert_runtime::__private::taylor };
     let group = &plan.group;
     // h{i} is history i of the plan's; the finishes read them in that
     // order.
@@ -428,7 +428,7 @@ fn order_k(d: &Ctx, t: &Transform, plan: &GroupPlan) -> (TokenStream, TokenStrea
 /// at most [`SUMS_PER_LOOP`] to a loop; after each loop the pairs' lanes
 /// are bound to their histories' names.
 fn loops(plan: &GroupPlan) -> TokenStream {
-    let tay = quote! { ::dalembert_runtime::taylor };
+    let tay = quote! { ::dalembert_runtime::__private::taylor };
     // (first history, declaration, term at j, binding after the loop)
     let mut sums: Vec<(usize, TokenStream, TokenStream, TokenStream)> = plan
         .pairs

@@ -44,7 +44,7 @@ pub(in crate::emit) fn scratch_struct(d: &Ctx) -> TokenStream {
             pub struct SeriesScratch;
         };
     }
-    let tay = quote! { ::dalembert_runtime::taylor };
+    let tay = quote! { ::dalembert_runtime::__private::taylor };
     let (mut fields, mut values) = (Vec::new(), Vec::new());
     if len > 0 {
         let len = Literal::usize_unsuffixed(len);
@@ -125,7 +125,7 @@ pub(super) fn prelude(d: &Ctx, t: &Transform, plan: &Plan) -> TokenStream {
         .filter(|(_, current)| *current)
         .map(|(j, _)| {
             let x = format_ident!("x{j}");
-            quote! { let mut #x = ::dalembert_runtime::taylor::Current::default(); }
+            quote! { let mut #x = ::dalembert_runtime::__private::taylor::Current::default(); }
         });
     let arrays = arrays(t);
     let arrays =

@@ -6,7 +6,7 @@
 
 use std::ops::Range;
 
-use dalembert_runtime::taylor::{self as tay, Coefficients};
+use dalembert_runtime::__private::taylor::{self as tay, Coefficients};
 
 use super::{Op, Series, Term, Transform};
 use crate::program::{Instr, Program, Slot};

@@ -6,7 +6,7 @@
 //! and whatever depends on them alone stay numbers, computed once per call
 //! as a small program of their own. Every instruction that reads a series
 //! becomes one or more [`Op`]s, each the recurrence for one coefficient of
-//! its result (`dalembert_runtime::taylor`): a product with a number is a
+//! its result (`dalembert_runtime::__private::taylor`): a product with a number is a
 //! scaling, a product of series a convolution, a power xⁿ (n ≤ 8)
 //! repeated products and, for n < 0, a reciprocal, sin and cos of one
 //! series one pair. Slots that the program writes again get a fresh series
@@ -474,7 +474,7 @@ impl Transform {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use dalembert_runtime::taylor as tay;
+    use dalembert_runtime::__private::taylor as tay;
 
     /// q̈ = −(g/l)·sin q (the pendulum): the transform's series of q is
     /// the solution's, checked against a tiny-step integration of the
@@ -520,8 +520,8 @@ mod tests {
         assert!((e.q[0][3] - (-w * q0.cos() * v0 / 6.0)).abs() < 1e-16);
         // Energy ½v² − w cos q along the polynomial, at τ up to 0.2.
         let energy = |tau: f64| {
-            let qq = tay::eval(&e.q[0], 20, tau);
-            let vv = tay::eval(&e.v[0], 20, tau);
+            let qq = dalembert_runtime::taylor::eval(&e.q[0], 20, tau);
+            let vv = dalembert_runtime::taylor::eval(&e.v[0], 20, tau);
             0.5 * vv * vv - w * qq.cos()
         };
         for j in 1..=10 {
@@ -572,7 +572,7 @@ mod tests {
         let numbers = tr.number_values(&[0.0], |p, x| p.eval(x));
         let c = tr.along(&numbers, &mut e, 30);
         for tau in [0.0, 0.1, -0.2, 0.3] {
-            let got = tay::eval(&c, 30, tau);
+            let got = dalembert_runtime::taylor::eval(&c, 30, tau);
             let want = f(2.0 + tau);
             assert!(
                 (got - want).abs() <= 1e-12 * want.abs(),

@@ -152,7 +152,7 @@ mod tests {
     use super::super::Evaluation;
     use super::*;
     use crate::program::{Func, Instr, Program};
-    use dalembert_runtime::taylor as tay;
+    use dalembert_runtime::__private::taylor as tay;
 
     /// x₁ − x₁·sin x₀ and −(x₀·x₁)·cos x₀, the shapes of the Euler-angle
     /// ball's q̈: no negation is left (the first subtracts, the second is

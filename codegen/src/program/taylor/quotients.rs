@@ -1,5 +1,5 @@
 //! Quotients: a product with a reciprocal, a·(1/b), as one division a/b
-//! (`dalembert_runtime::taylor::div`), whose recurrence is one convolution
+//! (`dalembert_runtime::__private::taylor::div`), whose recurrence is one convolution
 //! where the reciprocal and the product take two.
 
 use std::collections::{HashMap, HashSet};
@@ -85,7 +85,7 @@ mod tests {
     use super::super::Evaluation;
     use super::*;
     use crate::program::{Func, Instr, Program, Slot};
-    use dalembert_runtime::taylor as tay;
+    use dalembert_runtime::__private::taylor as tay;
 
     /// A product with a reciprocal is one quotient: sin(x)·x⁻¹ is a sin/cos
     /// pair and a division (no reciprocal left, temporaries numbered
@@ -133,7 +133,10 @@ mod tests {
         e.q[0][1] = 1.0;
         let c = tr.along(&[], &mut e, 25);
         for tau in [0.0, 0.1, -0.2, 0.3] {
-            let (got, want) = (tay::eval(&c, 25, tau), (2.0 + tau).sin() / (2.0 + tau));
+            let (got, want) = (
+                dalembert_runtime::taylor::eval(&c, 25, tau),
+                (2.0 + tau).sin() / (2.0 + tau),
+            );
             assert!((got - want).abs() <= 1e-15, "{tau}: {got} {want}");
         }
     }

@@ -14,7 +14,7 @@
 
 use std::collections::HashSet;
 
-use dalembert_runtime::taylor as tay;
+use dalembert_runtime::__private::taylor as tay;
 
 use super::evaluate::Evaluation;
 use super::{Series, Term, Transform};
