@@ -2,7 +2,8 @@
 //! against finite differences of whole simulations: Φ(T) δx₀ against
 //! Richardson-extrapolated central differences of x(T) over starts moved
 //! along admissible directions δx₀ (tangent to the constraint manifold,
-//! moved back onto it), at rtol 1e-12; runs through at least 10
+//! moved back onto it), at rtol 1e-12, and each collision instant's
+//! ∂t*/∂x₀ δx₀ against the differences of the instants; runs through at least 10
 //! collisions, with every integrator, on walls through square roots and
 //! quotients (interpreted), a nonholonomic sleigh in a round rink
 //! (interpreted), a holonomic pendulum at a wall and a spinning ball on a
@@ -35,31 +36,47 @@ fn interpreted<const N: usize>(name: &str, g: f64) -> Interpreted<N> {
     m
 }
 
-/// The state at `t_end` from (q, v), the collisions on the way, and Φ
-/// followed along when asked.
+/// ∂t*/∂x₀ of one collision, by (q₀, q̇₀).
+type Gradient<const N: usize> = ([f64; N], [f64; N]);
+
+/// What a run gives: its end state, its collision instants, and Φ with
+/// each collision's ∂t*/∂x₀ where it was followed.
+struct Run<const N: usize> {
+    end: State<N>,
+    instants: Vec<f64>,
+    phi: Option<(Variational<N>, Vec<Gradient<N>>)>,
+}
+
+/// The run to `t_end` from (q, v), Φ followed along when asked.
 fn run<M: Surfaces<N>, const N: usize>(
     m: &M,
     settings: Settings,
     (q, v): ([f64; N], [f64; N]),
     t_end: f64,
     follow: bool,
-) -> (State<N>, usize, Option<Variational<N>>) {
+) -> Run<N> {
     let start = State { t: 0.0, q, v };
     let mut sim =
         Simulator::new(m, start, settings).unwrap_or_else(|e| panic!("{}: {e:?}", m.name()));
     let mut phi = follow.then(|| Variational::new(1e-12));
-    let mut collisions = 0;
+    let (mut instants, mut gradients) = (Vec::new(), Vec::new());
     while sim.state().t < t_end {
         let step = sim
             .step(t_end)
             .unwrap_or_else(|e| panic!("{}: {e:?}", m.name()));
-        collisions += step.collision.is_some() as usize;
         if let Some(p) = &mut phi {
             p.follow(&sim, &step)
                 .unwrap_or_else(|e| panic!("{}: {e:?}", m.name()));
+            assert_eq!(p.collision_gradient().is_some(), step.collision.is_some());
+            gradients.extend(p.collision_gradient());
         }
+        instants.extend(step.collision.map(|c| c.t));
     }
-    (*sim.state(), collisions, phi)
+    Run {
+        end: *sim.state(),
+        instants,
+        phi: phi.map(|p| (p, gradients)),
+    }
 }
 
 /// ∇E at (q, v) by central differences.
@@ -91,41 +108,56 @@ fn check<M: Surfaces<N>, const N: usize>(m: &M, x0: ([f64; N], [f64; N]), t_end:
         .map(|_| admissible_direction(m, &x0.0, &x0.1, &mut seed).expect("a direction"))
         .collect();
     for (method, settings, eps, tol) in integrators() {
-        let (end, collisions, phi) = run(m, settings, x0, t_end, true);
+        let followed = run(m, settings, x0, t_end, true);
+        let (end, collisions) = (followed.end, followed.instants.len());
         assert!(
             collisions >= 10,
             "{} ({method}): {collisions} collisions",
             m.name()
         );
-        let phi = phi.unwrap();
+        let (phi, gradients) = followed.phi.unwrap();
         let (ge0, ge1) = (
             energy_gradient(m, &x0.0, &x0.1),
             energy_gradient(m, &end.q, &end.v),
         );
         for (k, (dq, dv)) in directions.iter().enumerate() {
             let (pq, pv) = phi.matrix().apply(dq, dv);
+            // The end state, then the collision instants.
             let at = |s: f64| -> Vec<f64> {
                 let q: [f64; N] = std::array::from_fn(|i| x0.0[i] + s * dq[i]);
                 let v: [f64; N] = std::array::from_fn(|i| x0.1[i] + s * dv[i]);
-                let (x, c, _) = run(m, settings, onto_manifold(m, q, v), t_end, false);
+                let r = run(m, settings, onto_manifold(m, q, v), t_end, false);
                 assert_eq!(
-                    c,
+                    r.instants.len(),
                     collisions,
                     "{} ({method}): a perturbed run met other walls",
                     m.name()
                 );
-                x.q.iter().chain(&x.v).copied().collect()
+                let mut x: Vec<f64> = r.end.q.iter().chain(&r.end.v).copied().collect();
+                x.extend(r.instants);
+                x
             };
             let fd = common::richardson(at, 2.0 * eps);
+            let (fd, fd_instants) = fd.split_at(2 * N);
             let got: Vec<f64> = pq.iter().chain(&pv).copied().collect();
-            let (worst, scale) = common::relative_gap(&got, &fd);
+            let (worst, scale) = common::relative_gap(&got, fd);
+            // ∂t*/∂x₀ · δx₀ for each collision.
+            let shifts: Vec<f64> = (gradients.iter())
+                .map(|(gq, gv)| (0..N).map(|i| gq[i] * dq[i] + gv[i] * dv[i]).sum())
+                .collect();
+            let (worst_t, _) = common::relative_gap(&shifts, fd_instants);
             eprintln!(
-                "{} ({method}), direction {k}: |Φ δx₀ − differences| / |differences| = {worst:.1e} ({collisions} collisions)",
+                "{} ({method}), direction {k}: |Φ δx₀ − differences| / |differences| = {worst:.1e}, instants {worst_t:.1e} ({collisions} collisions)",
                 m.name()
             );
             assert!(
                 worst <= tol,
                 "{} ({method}), direction {k}: Φ δx₀ {got:?}, differences {fd:?}",
+                m.name()
+            );
+            assert!(
+                worst_t <= tol,
+                "{} ({method}), direction {k}: ∂t*/∂x₀ δx₀ {shifts:?}, differences {fd_instants:?}",
                 m.name()
             );
             // ∇E(x(T))ᵀ Φ δx₀ = ∇E(x₀)ᵀ δx₀.

@@ -57,6 +57,8 @@ pub struct Variational<const N: usize> {
     phi: StateMatrix<N>,
     /// Φ at the end of the last step's flight: before its collision.
     before: StateMatrix<N>,
+    /// ∂t*/∂x₀ of the last step's collision.
+    instant: Option<([f64; N], [f64; N])>,
     /// Φ's own error control: Dormand–Prince at the tolerance of
     /// [`Variational::new`].
     method: DormandPrince,
@@ -104,6 +106,7 @@ impl<const N: usize> Variational<N> {
         Self {
             phi: StateMatrix::identity(),
             before: StateMatrix::identity(),
+            instant: None,
             method: DormandPrince {
                 rtol,
                 atol: rtol * 1e-2,
@@ -125,6 +128,14 @@ impl<const N: usize> Variational<N> {
         &self.before
     }
 
+    /// How the last step's collision instant t* moves with the start:
+    /// ∂t*/∂(q₀, q̇₀) = ∂t*/∂q · (the q rows of Φ⁻)
+    /// ([`crate::saltation::Saltation::dt_dq`]), as (by q₀, by q̇₀);
+    /// `None` when the step met no wall.
+    pub fn collision_gradient(&self) -> Option<([f64; N], [f64; N])> {
+        self.instant
+    }
+
     /// Advances Φ over `step`, the step `sim` has just made: along its
     /// motion, then through its collision if it ended at one.
     pub fn follow<M: Surfaces<N>>(
@@ -139,6 +150,7 @@ impl<const N: usize> Variational<N> {
             }
         }
         self.before = self.phi;
+        self.instant = None;
         if let Some(c) = &step.collision {
             let s = saltation(sim.model(), c.wall, &c.q, &c.v_minus).map_err(|error| {
                 VariationalError::Saltation {
@@ -146,6 +158,10 @@ impl<const N: usize> Variational<N> {
                     error,
                 }
             })?;
+            let by = |block: &[[f64; N]; N]| -> [f64; N] {
+                core::array::from_fn(|j| (0..N).map(|i| s.dt_dq[i] * block[i][j]).sum())
+            };
+            self.instant = Some((by(&self.phi.qq), by(&self.phi.qv)));
             self.phi = s.matrix.mul(&self.phi);
         }
         Ok(())
