@@ -433,3 +433,38 @@ fn by_a_parameter_of_a_holonomic_constraint_moves_the_start_onto_it() {
         );
     }
 }
+
+/// The start's derivative is taken with steps relative to the parameter:
+/// a point thrown down from height h at speed √h (`[initial] y = "h"`,
+/// `y_dot = "-sqrt(h)"`), run with h = 10⁻⁴ and `--by h`, starts with
+/// ∂y/∂h = 1 and ∂ẏ/∂h = −1/(2√h) = −50. (A step of 10⁻³ would take h below
+/// zero and the start's speed to NaN.)
+#[test]
+fn by_a_small_parameter_differentiates_its_start_in_its_own_scale() {
+    let dir = out_dir("sensitivity_by_small");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = PathBuf::from(&dir).join("thrown.toml");
+    std::fs::write(
+        &file,
+        "[model]\nname = \"thrown\"\n[parameters]\ng = { value = \"981/100\" }\nh = { value = \"1\" }\n\
+         [coordinates]\nnames = [\"y\"]\n[dynamics]\nkinetic_energy = \"y_dot^2/2\"\n\
+         potential = \"g*y\"\n[[wall]]\nname = \"floor\"\nsurface = \"y\"\n\
+         [initial]\ny = \"h\"\ny_dot = \"-sqrt(h)\"\n",
+    )
+    .unwrap();
+    let file = file.to_str().unwrap();
+    let args = [
+        "simulate", file, "--set", "h=1e-4", "--by", "h", "--t-end", "1e-3", "--out", &dir,
+    ];
+    let (ok, stdout, stderr) = dalembert(&args);
+    assert!(ok, "{stdout}{stderr}");
+    let csv = std::fs::read_to_string(PathBuf::from(&dir).join("thrown.csv")).unwrap();
+    let first: Vec<f64> = (csv.lines().nth(1).unwrap().split(','))
+        .skip(7)
+        .map(|c| c.parse().unwrap())
+        .collect();
+    assert!(
+        (first[0] - 1.0).abs() <= 1e-9 && (first[1] + 50.0).abs() <= 1e-6,
+        "{first:?}"
+    );
+}

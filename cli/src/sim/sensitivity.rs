@@ -141,7 +141,7 @@ pub(super) struct ByParameter<const N: usize> {
 /// parameters; coordinates that leave h(q) = 0 as p moves are taken to
 /// their nearest point on it, and a note says so), by
 /// Richardson-extrapolated central differences with the parameter moved by
-/// 10⁻³ max(1, |p|) and half that; `model` is left as it came.
+/// 10⁻³|p| (10⁻³ at p = 0) and half that; `model` is left as it came.
 pub(super) fn by_parameters<M: Surfaces<N>, const N: usize>(
     model: &mut M,
     set: &[(String, f64)],
@@ -179,7 +179,9 @@ pub(super) fn by_parameters<M: Surfaces<N>, const N: usize>(
             let x = start.state;
             Ok(x.q.iter().chain(&x.v).copied().collect())
         };
-        let h = 1e-3 * p0.abs().max(1.0);
+        // Relative to p, so that a small positive parameter (a mass, a
+        // length under a root) stays positive; absolute at p = 0.
+        let h = if p0 == 0.0 { 1e-3 } else { 1e-3 * p0.abs() };
         let mut central = |h: f64| -> Result<Vec<f64>, String> {
             let (plus, minus) = (at(p0 + h)?, at(p0 - h)?);
             Ok((plus.iter().zip(&minus))
@@ -194,6 +196,11 @@ pub(super) fn by_parameters<M: Surfaces<N>, const N: usize>(
         });
         model.set_parameter(k, p0);
         let d = derivative?;
+        if d.iter().any(|x| !x.is_finite()) {
+            return Err(format!(
+                "--by {name}: the start is not differentiable by {name} at {name} = {p0} (its differences are not finite)"
+            ));
+        }
         if moved {
             eprintln!(
                 "note: --by {name}: the start's coordinates leave the holonomic constraints h(q) = 0 as {name} moves; the start's derivative is that of their nearest point on them (in the metric of G)"
