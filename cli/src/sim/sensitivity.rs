@@ -34,10 +34,7 @@ impl<'p, const N: usize> Followed<'p, N> {
         rtol: f64,
     ) -> Self {
         let mut names = columns.as_ref().map_or(Vec::new(), |c| c.names.clone());
-        let state_names: Vec<&str> = (model.coordinate_names().iter())
-            .chain(model.velocity_names())
-            .copied()
-            .collect();
+        let state_names = state_names(model);
         for p in by {
             names.extend(state_names.iter().map(|a| format!("d{a}/d{}", p.name)));
         }
@@ -111,10 +108,7 @@ impl<'p, const N: usize> Followed<'p, N> {
         if let Some(phi) = &self.phi {
             report(model, start, t, phi)?;
         }
-        let names: Vec<&str> = (model.coordinate_names().iter())
-            .chain(model.velocity_names())
-            .copied()
-            .collect();
+        let names = state_names(model);
         for (p, s) in &self.by {
             let (dq, dv) = s.value();
             let values: Vec<String> = (names.iter().zip(dq.iter().chain(&dv)))
@@ -124,6 +118,15 @@ impl<'p, const N: usize> Followed<'p, N> {
         }
         Ok(())
     }
+}
+
+/// The names of the state's components: the coordinates, then the
+/// velocities.
+fn state_names<M: Surfaces<N>, const N: usize>(model: &M) -> Vec<&str> {
+    (model.coordinate_names().iter())
+        .chain(model.velocity_names())
+        .copied()
+        .collect()
 }
 
 /// A parameter the run is differentiated by (`--by`).
@@ -277,10 +280,7 @@ impl Columns {
         model: &M,
         spec: &str,
     ) -> Result<Self, String> {
-        let names: Vec<&str> = (model.coordinate_names().iter())
-            .chain(model.velocity_names())
-            .copied()
-            .collect();
+        let names = state_names(model);
         let index = |name: &str| {
             names.iter().position(|n| *n == name.trim()).ok_or_else(|| {
                 format!(
