@@ -99,13 +99,15 @@ fn variational(c: &mut Criterion<ThreadCpuTime>) {
 
 /// One model of [`variational`]: for each (method, settings, collisions),
 /// the run alone, with Φ and with ∂x/∂`p`.
-fn along_runs<M: Surfaces<N>, const N: usize>(
+fn along_runs<M: TaylorSeries<N>, const N: usize>(
     c: &mut Criterion<ThreadCpuTime>,
     m: &M,
     p: &str,
     methods: &[(&str, dalembert::runtime::simulate::Settings, usize)],
 ) {
-    use dalembert::runtime::simulate::{ParameterSensitivity, Simulator, State, Variational};
+    use dalembert::runtime::simulate::{
+        ParameterSensitivity, SeriesRoom, Simulator, State, Variational,
+    };
     let start = State {
         t: 0.0,
         q: m.initial_coordinates(),
@@ -120,7 +122,8 @@ fn along_runs<M: Surfaces<N>, const N: usize>(
     for &(name, settings, bounces) in methods {
         // (follow Φ, follow ∂x/∂p)
         let run = |(phi_on, dp_on): (bool, bool)| {
-            let mut sim = Simulator::new(m, start, settings).unwrap();
+            let mut room = SeriesRoom::new(m);
+            let mut sim = Simulator::with_series(&mut room, start, settings).unwrap();
             let mut phi = Variational::new(1e-10);
             let mut by_p = ParameterSensitivity::new(&dp, 1e-10);
             let mut met = 0;

@@ -44,7 +44,7 @@ use dalembert::models::{
 };
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
-    DormandPrince, Integrator, Settings, Simulator, State, Stats, Taylor,
+    DormandPrince, Integrator, SeriesRoom, Settings, Simulator, State, Stats, Taylor,
 };
 
 #[path = "../tests/common/bounce.rs"]
@@ -111,7 +111,7 @@ fn bounce_start(ball: &BallBounce) -> State<6> {
 /// with `read_energy`, the worst relative energy error at a bounce (else
 /// 0: a step works out its energy only when asked, so the timed runs leave
 /// it to the checks, except the one row that times reading it).
-fn bounce_run<M: Surfaces<6>>(
+fn bounce_run<M: TaylorSeries<6>>(
     ball: &M,
     start: State<6>,
     g: f64,
@@ -120,7 +120,8 @@ fn bounce_run<M: Surfaces<6>>(
     read_energy: bool,
 ) -> (Stats, f64, f64) {
     let e0 = ball.energy(&start.q, &start.v);
-    let mut sim = Simulator::new(ball, start, settings).unwrap();
+    let mut room = SeriesRoom::new(ball);
+    let mut sim = Simulator::with_series(&mut room, start, settings).unwrap();
     let (mut n, mut dt, mut de) = (0u64, 0.0f64, 0.0f64);
     let stats = sim
         .run((bounces as f64 + 0.5) * 4.0 / g, |s| {
@@ -180,7 +181,7 @@ fn series(c: &mut Criterion<ThreadCpuTime>) {
 }
 
 /// The §3.2.1 runs of one model in the group `name`.
-fn bounce_group<M: Surfaces<6>>(
+fn bounce_group<M: TaylorSeries<6>>(
     c: &mut Criterion<ThreadCpuTime>,
     name: &str,
     ball: &M,
@@ -224,14 +225,15 @@ const IMPACTS: u64 = 100;
 /// A simulation of `m` from `start` through [`IMPACTS`] collisions: stats
 /// and, with `read_energy` (the checks; the timed runs leave it out), the
 /// largest relative energy change seen at the end of a step.
-fn run<M: Surfaces<N>, const N: usize>(
+fn run<M: TaylorSeries<N>, const N: usize>(
     m: &M,
     start: State<N>,
     settings: Settings,
     read_energy: bool,
 ) -> (Stats, f64) {
     let e0 = m.energy(&start.q, &start.v);
-    let mut sim = Simulator::new(m, start, settings).unwrap();
+    let mut room = SeriesRoom::new(m);
+    let mut sim = Simulator::with_series(&mut room, start, settings).unwrap();
     let mut de = 0.0f64;
     let mut impacts = 0;
     let stats = sim
@@ -248,8 +250,9 @@ fn run<M: Surfaces<N>, const N: usize>(
 }
 
 /// When the [`IMPACTS`]-th collision happens.
-fn stats_t<M: Surfaces<N>, const N: usize>(m: &M, start: State<N>, settings: Settings) -> f64 {
-    let mut sim = Simulator::new(m, start, settings).unwrap();
+fn stats_t<M: TaylorSeries<N>, const N: usize>(m: &M, start: State<N>, settings: Settings) -> f64 {
+    let mut room = SeriesRoom::new(m);
+    let mut sim = Simulator::with_series(&mut room, start, settings).unwrap();
     let (mut impacts, mut t) = (0, 0.0);
     sim.run(f64::INFINITY, |s| {
         if let Some(c) = s.collision {
@@ -262,7 +265,7 @@ fn stats_t<M: Surfaces<N>, const N: usize>(m: &M, start: State<N>, settings: Set
     t
 }
 
-fn paired<M: Surfaces<N>, const N: usize>(
+fn paired<M: TaylorSeries<N>, const N: usize>(
     c: &mut Criterion<ThreadCpuTime>,
     group: &str,
     m: &M,
@@ -275,7 +278,7 @@ fn paired<M: Surfaces<N>, const N: usize>(
         .collect();
     let mut g = c.benchmark_group(group);
     for (name, settings, (stats, de)) in runs {
-        let order = Simulator::new(m, start, settings)
+        let order = Simulator::with_series(&mut SeriesRoom::new(m), start, settings)
             .unwrap()
             .taylor_order()
             .map_or(String::new(), |p| format!(" (order {p})"));
@@ -327,7 +330,7 @@ fn rolling(c: &mut Criterion<ThreadCpuTime>) {
 /// rtol 1e-13 and Taylor's method loosened to a tolerance of 1e-12 reach
 /// energy errors of the same size.
 fn chain(c: &mut Criterion<ThreadCpuTime>) {
-    fn one<M: Surfaces<N> + Default, const N: usize>(c: &mut Criterion<ThreadCpuTime>) {
+    fn one<M: TaylorSeries<N> + Default, const N: usize>(c: &mut Criterion<ThreadCpuTime>) {
         let m = M::default();
         let mut methods = with_fixed_orders(&[]);
         methods.push((

@@ -15,7 +15,7 @@
 use dalembert::models::{BallWallEuler, ChaplyginBall};
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
-    Integrator, Rk4, Settings, Simulator, StartRule, State, Taylor, starting_velocity,
+    Integrator, Rk4, SeriesRoom, Settings, Simulator, StartRule, State, Taylor, starting_velocity,
 };
 
 mod common;
@@ -171,7 +171,8 @@ fn energy_and_the_contact_momentum_are_conserved() {
         ("rk4", rk4, 1e-10),
     ] {
         let start = State { t: 0.0, q, v };
-        let mut sim = Simulator::new(&ball, start, settings).unwrap();
+        let mut room = SeriesRoom::new(&ball);
+        let mut sim = Simulator::with_series(&mut room, start, settings).unwrap();
         let (mut worst_e, mut worst_k) = (0.0f64, 0.0f64);
         let stats = sim
             .run(20.0, |step| {

@@ -14,7 +14,7 @@ mod common;
 
 use common::derived;
 use dalembert::runtime::prelude::*;
-use dalembert::runtime::simulate::{Integrator, Settings, Simulator, State, Taylor};
+use dalembert::runtime::simulate::{Integrator, SeriesRoom, Settings, Simulator, State, Taylor};
 use dalembert_codegen::interpret::Interpreted;
 
 /// The coin (tests/bodies/coin.toml) against closed forms: upright with
@@ -36,7 +36,9 @@ fn a_rolling_coin_moves_as_theory_says() {
 
     // Rolling straight along the heading φ = 0.3.
     let w = 3.0;
-    let mut sim = Simulator::new(&m, start(upright, [0.0, 0.0, w]), settings).unwrap();
+    let mut room = SeriesRoom::new(&m);
+    let mut sim =
+        Simulator::with_series(&mut room, start(upright, [0.0, 0.0, w]), settings).unwrap();
     sim.run(1.0, |_| true).unwrap();
     let x = sim.state();
     let along = [0.3f64.cos(), 0.3f64.sin()];
@@ -46,7 +48,9 @@ fn a_rolling_coin_moves_as_theory_says() {
     assert!((x.q[3] - upright).abs() < 1e-10, "straight: {x:?}");
 
     // Turning about the vertical diameter.
-    let mut sim = Simulator::new(&m, start(upright, [2.0, 0.0, 0.0]), settings).unwrap();
+    let mut room = SeriesRoom::new(&m);
+    let mut sim =
+        Simulator::with_series(&mut room, start(upright, [2.0, 0.0, 0.0]), settings).unwrap();
     sim.run(1.0, |_| true).unwrap();
     let x = sim.state();
     assert!(x.q[0].abs() < 1e-10 && x.q[1].abs() < 1e-10, "pivot: {x:?}");
@@ -63,7 +67,10 @@ fn a_rolling_coin_moves_as_theory_says() {
     let omega3 = (a_moment * precession * c0 - mass * g * r * c0 / (precession * s0))
         / (c_moment + mass * r * r);
     let spin = omega3 - precession * c0;
-    let mut sim = Simulator::new(&m, start(theta0, [precession, 0.0, spin]), settings).unwrap();
+    let mut room = SeriesRoom::new(&m);
+    let mut sim =
+        Simulator::with_series(&mut room, start(theta0, [precession, 0.0, spin]), settings)
+            .unwrap();
     let mut drift = 0.0f64;
     sim.run(2.0, |step| {
         let (q, v) = (&step.state.q, &step.state.v);
@@ -104,7 +111,8 @@ fn a_rolling_coin_moves_as_theory_says() {
     let x0 = start(1.2, [1.5, 0.0, 6.0]);
     let e0 = energy(&x0.q, &x0.v);
     assert!(slip(&x0.q, &x0.v) < 1e-12, "start: {x0:?}");
-    let mut sim = Simulator::new(&m, x0, settings).unwrap();
+    let mut room = SeriesRoom::new(&m);
+    let mut sim = Simulator::with_series(&mut room, x0, settings).unwrap();
     let mut worst = (0.0f64, 0.0f64);
     sim.run(2.0, |step| {
         let (q, v) = (&step.state.q, &step.state.v);
@@ -154,7 +162,8 @@ fn a_coin_bounces_off_smooth_walls() {
     let w = 2.0;
     let x0 = start(1.5, 0.0, std::f64::consts::FRAC_PI_2, [0.0, 0.0, w]);
     assert!((x0.v[0] + r * w).abs() < 1e-12, "{x0:?}");
-    let mut sim = Simulator::new(&m, x0, settings).unwrap();
+    let mut room = SeriesRoom::new(&m);
+    let mut sim = Simulator::with_series(&mut room, x0, settings).unwrap();
     let mut hits = Vec::new();
     sim.run(1.5, |step| {
         if let Some(c) = &step.collision {
@@ -182,7 +191,8 @@ fn a_coin_bounces_off_smooth_walls() {
     let x0 = start(1.5, 0.3, 1.3, [0.8, 0.0, 7.0]);
     let energy = |q: &[f64; 5], v: &[f64; 5]| m.kinetic_energy(q, v) + m.potential(q);
     let e0 = energy(&x0.q, &x0.v);
-    let mut sim = Simulator::new(&m, x0, settings).unwrap();
+    let mut room = SeriesRoom::new(&m);
+    let mut sim = Simulator::with_series(&mut room, x0, settings).unwrap();
     let (mut collisions, mut worst) = (0, 0.0f64);
     sim.run(6.0, |step| {
         let (q, v) = (&step.state.q, &step.state.v);
@@ -249,7 +259,8 @@ fn a_coin_bounces_off_a_rough_wall() {
     let e0 = energy(&x0.q, &x0.v);
     // Every impact on the rough wall: when, where, v⁻ and v⁺.
     let impacts = |settings| {
-        let mut sim = Simulator::new(&m, x0, settings).unwrap();
+        let mut room = SeriesRoom::new(&m);
+        let mut sim = Simulator::with_series(&mut room, x0, settings).unwrap();
         let mut rough = Vec::new();
         sim.run(20.0, |step| {
             if let Some(c) = &step.collision

@@ -5,7 +5,7 @@
 
 use dalembert::models::*;
 use dalembert::runtime::simulate::{
-    DormandPrince, Integrator, Settings, SimError, Simulator, State, Taylor,
+    DormandPrince, Integrator, SeriesRoom, Settings, SimError, Simulator, State, Taylor,
 };
 
 #[path = "common/bounce.rs"]
@@ -38,7 +38,8 @@ fn inside_the_steps(integrator: Integrator) -> f64 {
         integrator,
         ..Settings::default()
     };
-    let mut sim = Simulator::new(&ball, State { t: 0.0, q, v }, settings).unwrap();
+    let mut room = SeriesRoom::new(&ball);
+    let mut sim = Simulator::with_series(&mut room, State { t: 0.0, q, v }, settings).unwrap();
     assert!(sim.state_at(0.0).is_none(), "no step yet");
     let t_end = 20.5 * 2.0 * bounce::U / ball.params().g;
     let mut gap = 0.0f64;
@@ -84,7 +85,11 @@ fn dormand_prince_interpolant_is_the_motion_to_its_tolerance() {
 /// A Taylor run of the ball from just above the floor at t, moving along
 /// it: the flight grazes the floor (as `tests/simulation_errors.rs` sets it
 /// up), and the first step fails there.
-fn grazing(ball: &BallBounce, t: f64) -> Simulator<'_, BallBounce, 6> {
+fn grazing<'r>(
+    room: &'r mut SeriesRoom<'_, BallBounce, 6>,
+    t: f64,
+) -> Simulator<'r, BallBounce, 6> {
+    let ball = room.model();
     let r = ball.params().r;
     let q = [0.0, 0.0, r + 1e-15, 0.0, core::f64::consts::FRAC_PI_2, 0.0];
     let start = State {
@@ -96,7 +101,7 @@ fn grazing(ball: &BallBounce, t: f64) -> Simulator<'_, BallBounce, 6> {
         integrator: Integrator::Taylor(Taylor::default()),
         ..Settings::default()
     };
-    Simulator::new(ball, start, settings).unwrap()
+    Simulator::with_series(room, start, settings).unwrap()
 }
 
 /// A step that fails (here at a grazing contact found on the step's
@@ -105,7 +110,8 @@ fn grazing(ball: &BallBounce, t: f64) -> Simulator<'_, BallBounce, 6> {
 #[test]
 fn a_failed_step_leaves_no_motion() {
     let ball = BallBounce::default();
-    let mut sim = grazing(&ball, 0.0);
+    let mut room = SeriesRoom::new(&ball);
+    let mut sim = grazing(&mut room, 0.0);
     let Err(SimError::Grazing { t, .. }) = sim.step(1.0) else {
         panic!("expected a grazing contact");
     };
@@ -121,7 +127,8 @@ fn a_failed_step_leaves_no_motion() {
 #[test]
 fn a_failed_collision_leaves_the_clock_as_it_was() {
     let ball = BallBounce::default();
-    let mut sim = grazing(&ball, 0.1);
+    let mut room = SeriesRoom::new(&ball);
+    let mut sim = grazing(&mut room, 0.1);
     let mut instants = Vec::new();
     for _ in 0..8 {
         let Err(SimError::Grazing { t, .. }) = sim.step(1.0) else {

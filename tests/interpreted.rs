@@ -13,7 +13,7 @@ use dalembert::models::*;
 use dalembert::runtime::Rows;
 use dalembert::runtime::interval::Interval;
 use dalembert::runtime::prelude::*;
-use dalembert::runtime::simulate::{Integrator, Settings, Simulator, Taylor};
+use dalembert::runtime::simulate::{Integrator, SeriesRoom, Settings, Simulator, Taylor};
 use dalembert::runtime::taylor::{CAPACITY, Series};
 use dalembert_codegen::Derivation;
 use dalembert_codegen::interpret::Interpreted;
@@ -56,7 +56,7 @@ fn rows<const N: usize>(r: &Rows<N>) -> Vec<f64> {
 }
 
 /// Every function of the four traits at one (parameters, q, v).
-fn same_functions<M: Surfaces<N>, I: Surfaces<N>, const N: usize>(
+fn same_functions<M: TaylorSeries<N>, I: TaylorSeries<N>, const N: usize>(
     c: &M,
     i: &I,
     q: &[f64; N],
@@ -245,7 +245,7 @@ fn same_functions<M: Surfaces<N>, I: Surfaces<N>, const N: usize>(
 
 /// Names, the file's parameters and initial state, and every function at
 /// 50 random parameter sets and states.
-fn functions_agree<M: Surfaces<N> + FromParams, const N: usize>(d: &Derivation) {
+fn functions_agree<M: TaylorSeries<N> + FromParams, const N: usize>(d: &Derivation) {
     let mut c = M::with_params(Default::default());
     let mut i = interpreted::<N>(d);
     assert_eq!(c.name(), i.name());
@@ -272,14 +272,15 @@ fn functions_agree<M: Surfaces<N> + FromParams, const N: usize>(d: &Derivation) 
 
 /// A run of 5 s from the file's initial state: the same steps, the same
 /// collisions, the same states, energies, T and V.
-fn runs_agree<M: Surfaces<N> + FromParams, const N: usize>(d: &Derivation, settings: Settings) {
+fn runs_agree<M: TaylorSeries<N> + FromParams, const N: usize>(d: &Derivation, settings: Settings) {
     let module = d.model.name.as_str();
     let c = M::with_params(Default::default());
     let i = interpreted::<N>(d);
     let start = common::initial(&c);
+    let (mut room_c, mut room_i) = (SeriesRoom::new(&c), SeriesRoom::new(&i));
     let (Ok(mut sc), Ok(mut si)) = (
-        Simulator::new(&c, start, settings),
-        Simulator::new(&i, start, settings),
+        Simulator::with_series(&mut room_c, start, settings),
+        Simulator::with_series(&mut room_i, start, settings),
     ) else {
         panic!("{module}: the simulators do not start alike");
     };

@@ -567,7 +567,7 @@ fn arc_and_hyperbolic_functions_reach_the_emitted_programs() {
 #[test]
 fn emitted_series_of_arc_and_hyperbolic_functions_match_the_interpreter() {
     use dalembert::runtime::taylor::{Coefficients, Series};
-    use dalembert::runtime::{Dynamics, Surfaces, Walls};
+    use dalembert::runtime::{TaylorSeries, Walls};
     let text = arcs_free();
     assert!(!text.contains("constraints"));
     let d = derive("arcs_free", &text);
@@ -587,7 +587,7 @@ fn emitted_series_of_arc_and_hyperbolic_functions_match_the_interpreter() {
 #[allow(dead_code)]
 mod m;
 use dalembert_runtime::taylor::Series;
-use dalembert_runtime::{{Dynamics, FromParams, Surfaces, Walls}};
+use dalembert_runtime::{{FromParams, TaylorSeries, Walls}};
 fn main() {{
     let model = m::ArcsFree::with_params(Default::default());
     let mut s = Series::at(&{q:?}, &{v:?});

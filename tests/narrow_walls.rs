@@ -17,7 +17,7 @@ mod common;
 
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
-    Collision, Integrator, Rk4, Settings, Simulator, State, Taylor,
+    Collision, Integrator, Rk4, SeriesRoom, Settings, Simulator, State, Taylor,
 };
 use dalembert_codegen::interpret::Interpreted;
 
@@ -61,13 +61,14 @@ fn methods() -> Vec<(&'static str, Settings, f64)> {
 
 /// The first collision of `m` from `start` before `t_end`, checking that
 /// no reported state is beyond the wall.
-fn first_collision<M: Surfaces<N>, const N: usize>(
+fn first_collision<M: TaylorSeries<N>, const N: usize>(
     m: &M,
     start: State<N>,
     settings: Settings,
     t_end: f64,
 ) -> Option<Collision<M::Wall, N>> {
-    let mut sim = Simulator::new(m, start, settings).unwrap();
+    let mut room = SeriesRoom::new(m);
+    let mut sim = Simulator::with_series(&mut room, start, settings).unwrap();
     let mut first = None;
     sim.run(t_end, |s| {
         // Beyond the wall by no more than rounding of q moves f (the
@@ -95,7 +96,7 @@ fn first_collision<M: Surfaces<N>, const N: usize>(
 
 /// Each method's first collision against `reference` (None: none before
 /// `t_end`).
-fn check<M: Surfaces<N>, const N: usize>(
+fn check<M: TaylorSeries<N>, const N: usize>(
     what: &str,
     m: &M,
     start: State<N>,

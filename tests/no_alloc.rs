@@ -8,7 +8,9 @@ use dalembert::for_each_model;
 use dalembert::models::*;
 use dalembert::runtime::linalg::projector;
 use dalembert::runtime::prelude::*;
-use dalembert::runtime::simulate::{ParameterSensitivity, Settings, Simulator, State, Variational};
+use dalembert::runtime::simulate::{
+    ParameterSensitivity, SeriesRoom, Settings, Simulator, State, Variational,
+};
 
 struct Counting;
 
@@ -43,7 +45,7 @@ fn allocations_during(f: impl FnOnce()) -> usize {
 /// ([`Variational`]) and the derivative by the parameters along
 /// (1, 1, …) ([`ParameterSensitivity`]): the collisions met and the heap
 /// allocations made, from the simulator's construction on.
-fn simulated<M: Surfaces<N>, const N: usize>(
+fn simulated<M: TaylorSeries<N>, const N: usize>(
     m: &M,
     start: State<N>,
     settings: Settings,
@@ -53,7 +55,8 @@ fn simulated<M: Surfaces<N>, const N: usize>(
     let dp = [1.0; 16];
     let dp = &dp[..m.parameter_names().len()];
     let n = allocations_during(|| {
-        let mut sim = Simulator::new(m, start, settings).unwrap();
+        let mut room = SeriesRoom::new(m);
+        let mut sim = Simulator::with_series(&mut room, start, settings).unwrap();
         let mut phi = Variational::new(1e-10);
         let mut by_p = ParameterSensitivity::new(dp, 1e-10);
         while sim.state().t < t_end {
@@ -94,7 +97,7 @@ fn exercise<M: Walls<Q, N>, const Q: usize, const N: usize>(m: &M) -> f64 {
 
 /// The `Dynamics` and `Surfaces` functions of a model with coordinates,
 /// the closed-form and numeric q̈ included.
-fn exercise_motion<M: Surfaces<N>, const N: usize>(m: &M) -> f64 {
+fn exercise_motion<M: TaylorSeries<N>, const N: usize>(m: &M) -> f64 {
     let q: [f64; N] = std::array::from_fn(|i| 0.4 + 0.1 * i as f64);
     let v: [f64; N] = std::array::from_fn(|i| 0.3 - 0.2 * i as f64);
     let mut s = m.energy(&q, &v);

@@ -21,7 +21,7 @@ mod common;
 use dalembert::models::{BallBounce, PendulumWall};
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
-    ParameterSensitivity, Settings, Simulator, State, VariationalError,
+    ParameterSensitivity, SeriesRoom, Settings, Simulator, State, VariationalError,
 };
 
 use common::{integrators, onto_manifold, wall_model};
@@ -49,7 +49,7 @@ struct Run<const N: usize> {
 
 /// The run to `t_end` from `start`, s followed along `dp` from `ds0` when
 /// asked.
-fn run<M: Surfaces<N>, const N: usize>(
+fn run<M: TaylorSeries<N>, const N: usize>(
     m: &M,
     settings: Settings,
     start: ([f64; N], [f64; N]),
@@ -57,7 +57,8 @@ fn run<M: Surfaces<N>, const N: usize>(
     follow: Option<(&[f64], PhasePair<N>)>,
 ) -> Run<N> {
     let (q, v) = start;
-    let mut sim = Simulator::new(m, State { t: 0.0, q, v }, settings)
+    let mut room = SeriesRoom::new(m);
+    let mut sim = Simulator::with_series(&mut room, State { t: 0.0, q, v }, settings)
         .unwrap_or_else(|e| panic!("{}: {e:?}", m.name()));
     let mut s =
         follow.map(|(dp, (dq, dv))| ParameterSensitivity::new(dp, 1e-12).starting_at(dq, dv));
@@ -95,7 +96,7 @@ fn split<const N: usize>(x: &[f64]) -> ([f64; N], [f64; N]) {
 /// s(T) against the differences along each direction of `directions`,
 /// with the first `methods` integrators of [`integrators`], the
 /// differences' steps `scale` times the integrator's own.
-fn check<M: Surfaces<N> + Clone, const N: usize>(
+fn check<M: TaylorSeries<N> + Clone, const N: usize>(
     m: &M,
     (x0, t_end, scale): (([f64; N], [f64; N]), f64, f64),
     directions: &[(&str, Vec<f64>)],

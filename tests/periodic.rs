@@ -19,7 +19,7 @@ use common::{admissible_direction, dormand_prince, initial, richardson};
 /// A direction along the section at x (on the wall, leaving it): an
 /// admissible one with its component along the flow F = (v, q̈) taken
 /// off so that df·δq = 0 (F is admissible and crosses the section).
-fn along_section<M: Surfaces<N>, const N: usize>(
+fn along_section<M: TaylorSeries<N>, const N: usize>(
     m: &M,
     wall: M::Wall,
     x: &State<N>,
@@ -44,7 +44,7 @@ fn flat<const N: usize>(x: &State<N>) -> Vec<f64> {
 
 /// DΠ δ against Richardson differences of Π(project(x₀ + εδ)) for random
 /// δ along the section: relative error ≤ 1e-6 of |DΠ δ| + |δ|.
-fn jacobian_matches<M: Surfaces<N>, const N: usize>(m: &M, start: State<N>, returns: usize) {
+fn jacobian_matches<M: TaylorSeries<N>, const N: usize>(m: &M, start: State<N>, returns: usize) {
     let wall = m.walls()[0];
     let settings = dormand_prince(1e-12);
     let section = Section {

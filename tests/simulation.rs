@@ -14,7 +14,9 @@ mod bounce;
 mod common;
 use common::{dormand_prince, initial, pendulum_time};
 use dalembert::runtime::prelude::*;
-use dalembert::runtime::simulate::{Integrator, Rk4, Settings, Simulator, State, admissible};
+use dalembert::runtime::simulate::{
+    Integrator, Rk4, SeriesRoom, Settings, Simulator, State, admissible,
+};
 
 // ------------------------------------------------------------ helpers
 
@@ -53,7 +55,8 @@ fn free_pendulum_has_the_elliptic_period() {
         ),
     ] {
         let start = bob_at_rest(&p, theta0);
-        let mut sim = Simulator::new(&p, start, settings).unwrap();
+        let mut room = SeriesRoom::new(&p);
+        let mut sim = Simulator::with_series(&mut room, start, settings).unwrap();
         let mut worst = 0.0f64;
         let e0 = p.energy(&start.q, &start.v);
         sim.run(period, |s| {
@@ -214,7 +217,8 @@ fn aimed_steps_find_the_collisions_fixed_steps_find() {
     let chain = Chain3::default();
     let start = initial(&Chain3::default());
     let collisions = |settings: Settings| {
-        let mut sim = Simulator::new(&chain, start, settings).unwrap();
+        let mut room = SeriesRoom::new(&chain);
+        let mut sim = Simulator::with_series(&mut room, start, settings).unwrap();
         let mut found = Vec::new();
         sim.run(3.0, |s| {
             found.extend(s.collision);
@@ -428,7 +432,8 @@ fn the_box_is_the_same_box_at_every_scale() {
             dp.atol = 1e-14 * len.min(speed);
         }
         let unit = len / speed;
-        let mut sim = Simulator::new(&sys, start, settings).unwrap();
+        let mut room = SeriesRoom::new(&sys);
+        let mut sim = Simulator::with_series(&mut room, start, settings).unwrap();
         let mut seen = Vec::new();
         // Events are compared up to 39.5 units, short of the run's end, so
         // that one landing at the very end of one run and just after the end
@@ -484,7 +489,8 @@ fn stepping_to_the_next_collision_needs_no_end() {
         },
     ];
     for settings in methods {
-        let mut sim = Simulator::new(&ball, start, settings).unwrap();
+        let mut room = SeriesRoom::new(&ball);
+        let mut sim = Simulator::with_series(&mut room, start, settings).unwrap();
         for n in 1..=5 {
             let step = loop {
                 let step = sim

@@ -6,7 +6,9 @@
 
 use dalembert::models::{BallBounce, BallWallEuler, MassesOnLine};
 use dalembert::runtime::dynamics::DynamicsError;
-use dalembert::runtime::simulate::{Integrator, Rk4, Settings, SimError, Simulator, State, Taylor};
+use dalembert::runtime::simulate::{
+    Integrator, Rk4, SeriesRoom, Settings, SimError, Simulator, State, Taylor,
+};
 
 #[test]
 fn simultaneous_contacts_are_reported() {
@@ -141,7 +143,8 @@ fn taylor_steps_that_cannot_end_a_run_are_errors() {
         fixed_order: Some(2),
         ..Taylor::default()
     });
-    let mut sim = Simulator::new(&ball, start, order_2).unwrap();
+    let mut room = SeriesRoom::new(&ball);
+    let mut sim = Simulator::with_series(&mut room, start, order_2).unwrap();
     match sim.step(1.0) {
         Err(SimError::StepTooSmall { t, step }) => {
             assert_eq!(t, 0.0);
@@ -150,6 +153,7 @@ fn taylor_steps_that_cannot_end_a_run_are_errors() {
         other => panic!("expected StepTooSmall, got {other:?}"),
     }
     // The order the tolerance asks for steps on.
-    let mut sim = Simulator::new(&ball, start, with(Taylor::default())).unwrap();
+    let mut room = SeriesRoom::new(&ball);
+    let mut sim = Simulator::with_series(&mut room, start, with(Taylor::default())).unwrap();
     assert!(sim.step(1.0).unwrap().state.t > 0.1);
 }

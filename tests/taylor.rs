@@ -9,7 +9,7 @@ use dalembert::models::*;
 use dalembert::runtime::dynamics::DynamicsError;
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
-    Integrator, Settings, SimError, Simulator, State, Stats, Taylor,
+    Integrator, SeriesRoom, Settings, SimError, Simulator, State, Stats, Taylor,
 };
 use dalembert::runtime::taylor::Series;
 use std::cell::Cell;
@@ -32,7 +32,7 @@ fn taylor() -> Settings {
 /// 1e-15 relative, the centre's position within `position`, and one step
 /// per flight; returns the stats and every bounce (its instant and the
 /// state after it), the start first.
-fn bounces_with_taylor<M: Surfaces<6>>(
+fn bounces_with_taylor<M: TaylorSeries<6>>(
     ball: &M,
     (q, q_dot): ([f64; 6], [f64; 6]),
     r: f64,
@@ -46,7 +46,8 @@ fn bounces_with_taylor<M: Surfaces<6>>(
     };
     let (u, v) = (bounce::U, bounce::V);
     let e0 = ball.energy(&start.q, &start.v);
-    let mut sim = Simulator::new(ball, start, taylor()).unwrap();
+    let mut room = SeriesRoom::new(ball);
+    let mut sim = Simulator::with_series(&mut room, start, taylor()).unwrap();
     let flight = 2.0 * u / g;
     let bounces = 10_000;
     let mut n = 0usize;
@@ -92,7 +93,7 @@ type Bounce = (f64, [f64; 6], [f64; 6]);
 /// series truncated at order p is Taylor's step at the fixed order p
 /// (below order 19 the tolerance's asymptotic bound, e⁻², is the looser
 /// one, so it is the step the trials take).
-fn orders_needed<M: Surfaces<6>>(ball: &M, bounced: &[Bounce]) -> Vec<usize> {
+fn orders_needed<M: TaylorSeries<6>>(ball: &M, bounced: &[Bounce]) -> Vec<usize> {
     let t = Taylor::default();
     bounced
         .windows(2)
@@ -124,7 +125,7 @@ fn orders_needed<M: Surfaces<6>>(ball: &M, bounced: &[Bounce]) -> Vec<usize> {
 /// learnt, so there are at most as many as orders from the first trial's
 /// to the highest need, and one for the last step; each is followed by a
 /// step at the full order.
-fn assert_orders_learnt<M: Surfaces<6>>(ball: &M, stats: &Stats, bounced: &[Bounce]) {
+fn assert_orders_learnt<M: TaylorSeries<6>>(ball: &M, stats: &Stats, bounced: &[Bounce]) {
     let t = Taylor::default();
     let full = t.order_for(ball.series_work(), 6, ball.walls().len()) as u64;
     let first = Taylor::FIRST_TRIAL_ORDER as u64;
@@ -207,7 +208,8 @@ fn pendulum_period_with_taylor() {
         v: [0.0, 0.0],
     };
     let e0 = p.energy(&start.q, &start.v);
-    let mut sim = Simulator::new(&p, start, taylor()).unwrap();
+    let mut room = SeriesRoom::new(&p);
+    let mut sim = Simulator::with_series(&mut room, start, taylor()).unwrap();
     let mut worst = 0.0f64;
     let stats = sim
         .run(period, |s| {
@@ -239,7 +241,8 @@ fn pendulum_hits_the_wall_where_dormand_prince_does() {
         v: [0.0, 0.0],
     };
     let times = |settings: Settings| {
-        let mut sim = Simulator::new(&p, start, settings).unwrap();
+        let mut room = SeriesRoom::new(&p);
+        let mut sim = Simulator::with_series(&mut room, start, settings).unwrap();
         let mut t = Vec::new();
         sim.run(10.0, |s| {
             if let Some(c) = s.collision {
@@ -335,7 +338,9 @@ impl Dynamics<4> for Plain {
     fn constraint_drift(&self, q: &[f64; 4], v: &[f64; 4]) -> [f64; 4] {
         self.0.constraint_drift(q, v)
     }
-    type SeriesScratch = <Chain4 as Dynamics<4>>::SeriesScratch;
+}
+impl TaylorSeries<4> for Plain {
+    type SeriesScratch = <Chain4 as TaylorSeries<4>>::SeriesScratch;
     fn taylor_series(
         &self,
         s: &mut Series<4>,
@@ -351,11 +356,6 @@ impl Dynamics<4> for Plain {
         }
         done
     }
-}
-impl Surfaces<4> for Plain {
-    fn surface(&self, wall: W4, q: &[f64; 4]) -> f64 {
-        self.0.surface(wall, q)
-    }
     fn surface_series(
         &self,
         wall: W4,
@@ -366,21 +366,30 @@ impl Surfaces<4> for Plain {
         self.1 != Offered::Nothing && self.0.surface_series(wall, s, scratch, out)
     }
 }
+impl Surfaces<4> for Plain {
+    fn surface(&self, wall: W4, q: &[f64; 4]) -> f64 {
+        self.0.surface(wall, q)
+    }
+}
 
-/// A model without series: Taylor's method is refused with a typed error,
-/// not run wrongly.
+/// A model without series, or a simulator without room for them: Taylor's
+/// method is refused with a typed error, not run wrongly.
 #[test]
 fn models_without_series_refuse_taylor() {
     let chain = Chain4::default();
     let start = initial(&chain);
-    // The generated model itself has them and runs.
-    assert!(Simulator::new(&chain, start, taylor()).is_ok());
+    // The generated model itself has them and runs, given room.
+    let mut room = SeriesRoom::new(&chain);
+    assert!(Simulator::with_series(&mut room, start, taylor()).is_ok());
+    // A simulator built without room has none to step in.
     assert!(matches!(
-        Simulator::new(
-            &Plain(chain, Offered::Nothing, Cell::default()),
-            start,
-            taylor()
-        ),
+        Simulator::new(&chain, start, taylor()),
+        Err(SimError::NoSeries)
+    ));
+    let plain = Plain(chain, Offered::Nothing, Cell::default());
+    let mut room = SeriesRoom::new(&plain);
+    assert!(matches!(
+        Simulator::with_series(&mut room, start, taylor()),
         Err(SimError::NoSeries)
     ));
 }
@@ -392,7 +401,8 @@ fn models_without_series_refuse_taylor() {
 fn non_finite_series_stop_the_run() {
     let chain = Chain4::default();
     let model = Plain(chain, Offered::Poisoned, Cell::default());
-    let mut sim = Simulator::new(&model, initial(&chain), taylor()).unwrap();
+    let mut room = SeriesRoom::new(&model);
+    let mut sim = Simulator::with_series(&mut room, initial(&chain), taylor()).unwrap();
     let err = sim.run(10.0, |_| true).unwrap_err();
     assert!(
         matches!(
@@ -414,7 +424,8 @@ fn steps_work_out_the_energy_only_when_asked() {
     let chain = Chain4::default();
     let model = Plain(chain, Offered::Series, Cell::default());
     for settings in [taylor(), Settings::default()] {
-        let mut sim = Simulator::new(&model, initial(&chain), settings).unwrap();
+        let mut room = SeriesRoom::new(&model);
+        let mut sim = Simulator::with_series(&mut room, initial(&chain), settings).unwrap();
         let mut last = None;
         let stats = sim
             .run(2.0, |s| {
@@ -446,7 +457,8 @@ fn triple_pendulum_tip_meets_the_floor_with_taylor() {
     let start = initial(&chain);
     let e0 = chain.energy(&start.q, &start.v);
     let impacts = |settings: Settings| {
-        let mut sim = Simulator::new(&chain, start, settings).unwrap();
+        let mut room = SeriesRoom::new(&chain);
+        let mut sim = Simulator::with_series(&mut room, start, settings).unwrap();
         let (mut found, mut de) = (Vec::new(), 0.0f64);
         sim.run(3.0, |s| {
             de = de.max((s.energy(&chain) - e0).abs() / e0.abs());
@@ -496,10 +508,13 @@ fn rolling_ball_in_euler_angles_and_quaternions_with_taylor() {
     let p = euler.params();
     let alpha = p.a * p.m * p.r * p.r / (p.J + p.m * p.r * p.r);
     let first = (-0.5 + (0.25 + 2.0 * alpha * (1.5 - p.r)).sqrt()) / alpha;
-    fn run<M: Surfaces<N> + Default, const N: usize>(m: &M) -> (Vec<(f64, f64, f64)>, f64, f64) {
+    fn run<M: TaylorSeries<N> + Default, const N: usize>(
+        m: &M,
+    ) -> (Vec<(f64, f64, f64)>, f64, f64) {
         let start = initial(m);
         let e0 = m.energy(&start.q, &start.v);
-        let mut sim = Simulator::new(m, start, taylor()).unwrap();
+        let mut room = SeriesRoom::new(m);
+        let mut sim = Simulator::with_series(&mut room, start, taylor()).unwrap();
         let (mut out, mut de, mut dh) = (Vec::new(), 0.0f64, 0.0f64);
         let stats = sim
             .run(f64::INFINITY, |s| {
@@ -582,7 +597,8 @@ fn rolling_ball_in_euler_angles_at_the_models_order() {
             integrator,
             ..Settings::default()
         };
-        let mut sim = Simulator::new(&ball, start, settings).unwrap();
+        let mut room = SeriesRoom::new(&ball);
+        let mut sim = Simulator::with_series(&mut room, start, settings).unwrap();
         let (mut impacts, mut de) = (Vec::new(), 0.0f64);
         let stats = sim
             .run(f64::INFINITY, |s| {
@@ -605,7 +621,7 @@ fn rolling_ball_in_euler_angles_at_the_models_order() {
     let (default, at_default, de) = run(Integrator::Taylor(Taylor::default()));
     let (at_20, impacts_20, _) = run(fixed(20));
     let (_, impacts_28, de_28) = run(fixed(28));
-    let order = Simulator::new(&ball, start, taylor())
+    let order = Simulator::with_series(&mut SeriesRoom::new(&ball), start, taylor())
         .unwrap()
         .taylor_order()
         .unwrap();

@@ -23,7 +23,7 @@ fn binomial(n: usize, k: usize) -> f64 {
 }
 
 /// The checks of one model at one random case (parameters, q, v).
-fn check_series<M: Surfaces<N>, const N: usize>(
+fn check_series<M: TaylorSeries<N>, const N: usize>(
     m: &M,
     q: &[f64; N],
     v: [f64; N],
@@ -144,7 +144,7 @@ mod series_agree_with_themselves {
 /// model with coordinates: in closed form, or by elimination).
 #[test]
 fn series_exist_where_closed_forms_do() {
-    fn both<M: Dynamics<N> + Default, const N: usize>() -> (bool, bool) {
+    fn both<M: TaylorSeries<N> + Default, const N: usize>() -> (bool, bool) {
         let m = M::default();
         let (q, v) = ([0.5; N], [0.0; N]);
         let mut s = Series::at(&q, &v);
@@ -225,7 +225,7 @@ fn pendulum_series_is_the_angles() {
 /// file's start, about the middle one, where the series is computed
 /// (q̇ₖ = q̈⁽ᵏ⁻¹⁾/k!). The differences are of orders h⁴, h⁴ and h², and
 /// the run's error weighs on them as 1/h, 1/h² and 1/h³.
-fn against_differences<M: Surfaces<N> + Default, const N: usize>() {
+fn against_differences<M: TaylorSeries<N> + Default, const N: usize>() {
     let m = M::default();
     let start = initial(&m);
     let mut s = Series::at(&start.q, &start.v);

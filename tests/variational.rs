@@ -21,7 +21,7 @@ use std::path::Path;
 
 use dalembert::models::{BallBounce, PendulumWall};
 use dalembert::runtime::prelude::*;
-use dalembert::runtime::simulate::{Settings, Simulator, State, Variational};
+use dalembert::runtime::simulate::{SeriesRoom, Settings, Simulator, State, Variational};
 use dalembert_codegen::interpret::Interpreted;
 
 use common::{admissible_direction, integrators, lcg, onto_manifold};
@@ -48,7 +48,7 @@ struct Run<const N: usize> {
 }
 
 /// The run to `t_end` from (q, v), Φ followed along when asked.
-fn run<M: Surfaces<N>, const N: usize>(
+fn run<M: TaylorSeries<N>, const N: usize>(
     m: &M,
     settings: Settings,
     (q, v): ([f64; N], [f64; N]),
@@ -56,8 +56,9 @@ fn run<M: Surfaces<N>, const N: usize>(
     follow: bool,
 ) -> Run<N> {
     let start = State { t: 0.0, q, v };
-    let mut sim =
-        Simulator::new(m, start, settings).unwrap_or_else(|e| panic!("{}: {e:?}", m.name()));
+    let mut room = SeriesRoom::new(m);
+    let mut sim = Simulator::with_series(&mut room, start, settings)
+        .unwrap_or_else(|e| panic!("{}: {e:?}", m.name()));
     let mut phi = follow.then(|| Variational::new(1e-12));
     let (mut instants, mut gradients) = (Vec::new(), Vec::new());
     while sim.state().t < t_end {
@@ -101,7 +102,7 @@ fn energy_gradient<M: Dynamics<N>, const N: usize>(
     (std::array::from_fn(by), std::array::from_fn(|i| by(N + i)))
 }
 
-fn check<M: Surfaces<N>, const N: usize>(m: &M, x0: ([f64; N], [f64; N]), t_end: f64) {
+fn check<M: TaylorSeries<N>, const N: usize>(m: &M, x0: ([f64; N], [f64; N]), t_end: f64) {
     let x0 = onto_manifold(m, x0.0, x0.1);
     let mut seed = 17_u64;
     let directions: Vec<_> = (0..3)
@@ -279,7 +280,8 @@ fn energy_is_kept_through_ten_thousand_bounces() {
         .map(|(dq, dv)| dot(&ge0, (dq, dv)))
         .collect();
     for (method, settings, _, _) in integrators().into_iter().take(2) {
-        let mut sim = Simulator::new(&m, start, settings).unwrap();
+        let mut room = SeriesRoom::new(&m);
+        let mut sim = Simulator::with_series(&mut room, start, settings).unwrap();
         let mut phi = Variational::new(1e-12);
         let (mut bounces, mut worst, mut growth) = (0, 0.0_f64, 0.0_f64);
         while bounces < 10_000 {

@@ -21,7 +21,7 @@ mod common;
 
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
-    Collision, Integrator, Rk4, Settings, SimError, Simulator, State, Stats, Taylor,
+    Collision, Integrator, Rk4, SeriesRoom, Settings, SimError, Simulator, State, Stats, Taylor,
 };
 use dalembert::runtime::taylor::{Coefficients, Series};
 use dalembert_codegen::interpret::Interpreted;
@@ -95,7 +95,7 @@ type Outcome<W, const N: usize> = Result<(Vec<Collision<W, N>>, Stats), SimError
 /// step's state and at every collision, which is on its wall, and a disk's
 /// state within the unit circle) and that the energy is kept to `energy`
 /// relative.
-fn run<M: Surfaces<N>, const N: usize>(
+fn run<M: TaylorSeries<N>, const N: usize>(
     m: &M,
     start: State<N>,
     settings: Settings,
@@ -104,7 +104,8 @@ fn run<M: Surfaces<N>, const N: usize>(
 ) -> Outcome<M::Wall, N> {
     let e0 = m.energy(&start.q, &start.v);
     let scale = e0.abs().max(1.0);
-    let mut sim = Simulator::new(m, start, settings)?;
+    let mut room = SeriesRoom::new(m);
+    let mut sim = Simulator::with_series(&mut room, start, settings)?;
     let mut found = Vec::new();
     let mut last = start.t;
     let stats = sim.run(t_end, |s| {
@@ -360,7 +361,7 @@ fn no_state_outside_from_random_starts() {
             stopped += 1;
         }
     };
-    fn each<M: Surfaces<N>, const N: usize>(
+    fn each<M: TaylorSeries<N>, const N: usize>(
         m: &M,
         start: State<N>,
         tally: &mut impl FnMut(Result<usize, String>),
@@ -520,7 +521,10 @@ impl Dynamics<2> for Misled<'_> {
     fn closed_form_accelerations(&self, q: &[f64; 2], v: &[f64; 2]) -> Option<[f64; 2]> {
         self.0.closed_form_accelerations(q, v)
     }
-    type SeriesScratch = <Interpreted<2> as Dynamics<2>>::SeriesScratch;
+}
+
+impl TaylorSeries<2> for Misled<'_> {
+    type SeriesScratch = <Interpreted<2> as TaylorSeries<2>>::SeriesScratch;
     fn taylor_series(
         &self,
         s: &mut Series<2>,
@@ -528,12 +532,6 @@ impl Dynamics<2> for Misled<'_> {
         order: usize,
     ) -> bool {
         self.0.taylor_series(s, scratch, order)
-    }
-}
-
-impl Surfaces<2> for Misled<'_> {
-    fn surface(&self, wall: Wall, q: &[f64; 2]) -> f64 {
-        self.0.surface(wall, q)
     }
     fn surface_series(
         &self,
@@ -545,5 +543,11 @@ impl Surfaces<2> for Misled<'_> {
         let done = self.0.surface_series(wall, s, scratch, out);
         out[0] += 0.5;
         done
+    }
+}
+
+impl Surfaces<2> for Misled<'_> {
+    fn surface(&self, wall: Wall, q: &[f64; 2]) -> f64 {
+        self.0.surface(wall, q)
     }
 }

@@ -26,7 +26,9 @@ use std::process::Command;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use dalembert::models::BallBounce;
 use dalembert::runtime::prelude::*;
-use dalembert::runtime::simulate::{Integrator, Settings, Simulator, State, Taylor, residual};
+use dalembert::runtime::simulate::{
+    Integrator, SeriesRoom, Settings, Simulator, State, Taylor, residual,
+};
 
 #[path = "../../benches/common/cpu_time.rs"]
 #[allow(dead_code)] // the thread clock is not used here
@@ -54,7 +56,7 @@ fn start<M: Dynamics<N>, const N: usize>(m: &M) -> State<N> {
 
 /// One row as the command line writes it: t, q, q̇, energy, |A q̇|, |h(q)|
 /// and the wall's name on the row before a collision.
-fn row<M: Surfaces<N>, const N: usize>(
+fn row<M: TaylorSeries<N>, const N: usize>(
     out: &mut impl Write,
     m: &M,
     t: f64,
@@ -94,7 +96,8 @@ fn library_csv(m: &BallBounce, path: &Path) -> u64 {
     out.write_all(header.as_bytes()).unwrap();
     let s = start(m);
     row(&mut out, m, 0.0, &s.q, &s.v, "");
-    let mut sim = Simulator::new(m, s, settings()).unwrap();
+    let mut room = SeriesRoom::new(m);
+    let mut sim = Simulator::with_series(&mut room, s, settings()).unwrap();
     let grid = |k: f64| (k * EVERY).min(T_END);
     let mut k = 1.0;
     while sim.state().t < T_END {
@@ -152,7 +155,8 @@ fn bench(c: &mut Criterion<ProcessCpuTime>) {
         ours == std::fs::read(dir.join("ball_bounce.csv")).unwrap(),
         "the library's CSV differs from the command line's"
     );
-    let mut sim = Simulator::new(&m, start(&m), settings()).unwrap();
+    let mut room = SeriesRoom::new(&m);
+    let mut sim = Simulator::with_series(&mut room, start(&m), settings()).unwrap();
     assert_eq!(sim.run(T_END, |_| true).unwrap().collisions, BOUNCES);
 
     let mut group = c.benchmark_group("ball_bounce_10000_bounces_taylor");
@@ -160,7 +164,8 @@ fn bench(c: &mut Criterion<ProcessCpuTime>) {
     group.sample_size(20);
     group.bench_function("library", |b| {
         b.iter(|| {
-            let mut sim = Simulator::new(&m, start(&m), settings()).unwrap();
+            let mut room = SeriesRoom::new(&m);
+            let mut sim = Simulator::with_series(&mut room, start(&m), settings()).unwrap();
             sim.run(T_END, |_| true).unwrap()
         })
     });

@@ -63,7 +63,7 @@ struct Periodic<'a>(&'a PeriodicArgs);
 impl WithModel for Periodic<'_> {
     type Output = bool;
 
-    fn with<M: Surfaces<N>, const N: usize>(
+    fn with<M: TaylorSeries<N>, const N: usize>(
         self,
         model: M,
         derived: &[String],

@@ -101,7 +101,7 @@ pub trait WithModel {
     /// The command's result.
     type Output;
     /// Runs on `model`, whose derived parameters are `derived`.
-    fn with<M: Surfaces<N>, const N: usize>(
+    fn with<M: TaylorSeries<N>, const N: usize>(
         self,
         model: M,
         derived: &[String],

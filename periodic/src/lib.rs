@@ -36,13 +36,13 @@ mod svd;
 use nalgebra::{DMatrix, DVector};
 use svd::Svd;
 
-use dalembert_runtime::Surfaces;
 use dalembert_runtime::linalg::{self, ProjectorError};
 use dalembert_runtime::saltation::StateMatrix;
 use dalembert_runtime::simulate::{
-    Return, ReturnError, Section, Settings, Simulator, State, admissible, return_map,
+    Return, ReturnError, Section, SeriesRoom, Settings, Simulator, State, admissible, return_map,
     tangent_direction,
 };
+use dalembert_runtime::{Surfaces, TaylorSeries};
 
 /// How an orbit is searched for.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -227,7 +227,7 @@ impl<W> From<ReturnError<W>> for PeriodicError<W> {
 /// The first state of the section on the motion from `start`: `start`
 /// itself if it is on the wall and moving away, else the state just after
 /// the first collision with the wall.
-pub fn onto_section<M: Surfaces<N>, const N: usize>(
+pub fn onto_section<M: TaylorSeries<N>, const N: usize>(
     model: &M,
     start: State<N>,
     section: &Section<M::Wall>,
@@ -241,7 +241,9 @@ pub fn onto_section<M: Surfaces<N>, const N: usize>(
     if f.abs() <= 1e-12 * scale && sigma > 0.0 {
         return Ok(start);
     }
-    let mut sim = Simulator::new(model, start, settings).map_err(ReturnError::Simulation)?;
+    let mut room = SeriesRoom::new(model);
+    let mut sim =
+        Simulator::with_series(&mut room, start, settings).map_err(ReturnError::Simulation)?;
     let t_end = start.t + section.t_max;
     while sim.state().t < t_end {
         let step = sim.step(t_end).map_err(ReturnError::Simulation)?;
@@ -260,7 +262,7 @@ pub fn onto_section<M: Surfaces<N>, const N: usize>(
 
 /// Searches a periodic orbit of `section` from `start` (brought onto the
 /// section first, [`onto_section`]); see the module doc.
-pub fn find<M: Surfaces<N>, const N: usize>(
+pub fn find<M: TaylorSeries<N>, const N: usize>(
     model: &M,
     start: State<N>,
     section: &Section<M::Wall>,

@@ -7,7 +7,7 @@
 //! Treschev & Zubelevich, eqs. 2.4 and 2.13) always; a model with
 //! coordinates also [`Dynamics`] (the motion between collisions) and
 //! [`Surfaces`] (each wall's f(q)), which is what the hybrid simulator
-//! needs.
+//! needs, and [`TaylorSeries`] (the series Taylor's method steps on).
 //!
 //! The crate is `#![no_std]`, never allocates and never panics on finite
 //! input. Dimensions are const generics: `Q` coordinates and `N` velocity
@@ -108,11 +108,11 @@ impl<const N: usize> Values<N> {
 }
 
 mod model;
-pub use model::{Dynamics, FromParams, Model, Surfaces, Walls};
+pub use model::{Dynamics, FromParams, Model, Surfaces, TaylorSeries, Walls};
 
 /// The model traits, for `use dalembert_runtime::prelude::*`.
 pub mod prelude {
-    pub use crate::{Dynamics, FromParams, Model, Surfaces, Walls};
+    pub use crate::{Dynamics, FromParams, Model, Surfaces, TaylorSeries, Walls};
 }
 
 /// What generated code calls besides the traits; not part of the API.

@@ -1,6 +1,7 @@
 //! The traits a generated model implements, layered by what it has (in the
 //! manner of embedded-hal): every model is a [`Model`] with [`Walls`]; a
-//! model with coordinates (`Q = N`) adds [`Dynamics`] and [`Surfaces`].
+//! model with coordinates (`Q = N`) adds [`Dynamics`] and [`Surfaces`],
+//! and one with Taylor series [`TaylorSeries`].
 //! An instantaneous model (`Q = 0`, the paper's §3) implements only the
 //! first two: it has no motion and no surfaces.
 
@@ -270,37 +271,6 @@ pub trait Dynamics<const N: usize>: Model<N, N> {
         Some((by_q, by_v))
     }
 
-    /// Room for the intermediate coefficients of the model's series
-    /// ([`Dynamics::taylor_series`], [`Surfaces::surface_series`]), kept by
-    /// the caller from one call to the next, so that a call neither zeroes
-    /// its intermediate arrays nor holds them on its stack (`chain_8`'s are
-    /// 22 KiB, and 64.5 KiB of coefficient pairs, which
-    /// its history loops read two at a time). A generated model's is its
-    /// module's `SeriesScratch`; `()`
-    /// where a model keeps none. `Default` gives room ready for any call;
-    /// what a call leaves in it is only ever overwritten, never read, by the
-    /// next.
-    type SeriesScratch: Default;
-
-    /// The Taylor series of the motion through the state held at order 0
-    /// of `series` (q(t₀), q̇(t₀)): fills its coefficients of orders 1 to
-    /// `order` (at most [`crate::taylor::MAX_ORDER`]) and sets its order,
-    /// with `scratch` as room for the intermediate series (pass the same
-    /// one call after call; `&mut Default::default()` for a single call).
-    /// Generated models have it wherever they write q̈ out (the Taylor
-    /// transform of that program, [`Dynamics::closed_form_accelerations`]);
-    /// `false` (the default) means the model has none and the series is
-    /// untouched.
-    fn taylor_series(
-        &self,
-        series: &mut Series<N>,
-        scratch: &mut Self::SeriesScratch,
-        order: usize,
-    ) -> bool {
-        let _ = (series, scratch, order);
-        false
-    }
-
     /// Total energy T + V.
     fn energy(&self, q: &[f64; N], v: &[f64; N]) -> f64 {
         self.kinetic_energy(q, v) + self.potential(q)
@@ -356,11 +326,49 @@ pub trait Surfaces<const N: usize>: Dynamics<N> + Walls<N, N> {
         let _ = (wall, q);
         None
     }
+}
+
+/// The Taylor series of a model's motion and of its walls' f: what
+/// Taylor's method ([`crate::simulate::Integrator::Taylor`]) steps on.
+/// Generated models implement it wherever they write q̈ out (the Taylor
+/// transform of that program, [`Dynamics::closed_form_accelerations`]). A
+/// model without series needs none of it: the Runge–Kutta methods use
+/// [`Surfaces`] alone. The simulator keeps the series and the scratch room
+/// in a [`crate::simulate::SeriesRoom`], which only a simulator built
+/// with [`crate::simulate::Simulator::with_series`] carries.
+pub trait TaylorSeries<const N: usize>: Surfaces<N> {
+    /// Room for the intermediate coefficients of the model's series
+    /// ([`TaylorSeries::taylor_series`], [`TaylorSeries::surface_series`]),
+    /// kept by the caller from one call to the next, so that a call
+    /// neither zeroes its intermediate arrays nor holds them on its stack
+    /// (`chain_8`'s are 22 KiB, and 64.5 KiB of coefficient pairs, which
+    /// its history loops read two at a time). A generated model's is its
+    /// module's `SeriesScratch`; `()` where a model keeps none. `Default`
+    /// gives room ready for any call; what a call leaves in it is only
+    /// ever overwritten, never read, by the next.
+    type SeriesScratch: Default;
+
+    /// The Taylor series of the motion through the state held at order 0
+    /// of `series` (q(t₀), q̇(t₀)): fills its coefficients of orders 1 to
+    /// `order` (at most [`crate::taylor::MAX_ORDER`]) and sets its order,
+    /// with `scratch` as room for the intermediate series (pass the same
+    /// one call after call; `&mut Default::default()` for a single call).
+    /// `false` (the default) means the model has none and the series is
+    /// untouched.
+    fn taylor_series(
+        &self,
+        series: &mut Series<N>,
+        scratch: &mut Self::SeriesScratch,
+        order: usize,
+    ) -> bool {
+        let _ = (series, scratch, order);
+        false
+    }
 
     /// The Taylor coefficients of t ↦ f(q(t)) along `series` (see
-    /// [`Dynamics::taylor_series`], whose `scratch` this shares), orders 0
-    /// to `series.order`, into `out`. `false` (the default) means the model
-    /// has none.
+    /// [`TaylorSeries::taylor_series`], whose `scratch` this shares),
+    /// orders 0 to `series.order`, into `out`. `false` (the default) means
+    /// the model has none.
     fn surface_series(
         &self,
         wall: Self::Wall,
@@ -372,10 +380,11 @@ pub trait Surfaces<const N: usize>: Dynamics<N> + Walls<N, N> {
         false
     }
 
-    /// The work per order of [`Dynamics::taylor_series`] and of the walls'
-    /// [`Surfaces::surface_series`], from which Taylor's method picks the
-    /// order that costs least per unit of time. `None` (the default):
-    /// unknown, and the method keeps the order its tolerance asks for.
+    /// The work per order of [`TaylorSeries::taylor_series`] and of the
+    /// walls' [`TaylorSeries::surface_series`], from which Taylor's method
+    /// picks the order that costs least per unit of time. `None` (the
+    /// default): unknown, and the method keeps the order its tolerance
+    /// asks for.
     fn series_work(&self) -> Option<SeriesWork> {
         None
     }

@@ -60,7 +60,7 @@ impl core::iter::Sum for Work {
 
 /// What a model's series cost: the motion's (q̈'s program, whose orders 0
 /// to p − 1 give the series of order p) and every wall's f along it, summed
-/// ([`crate::Surfaces::series_work`]). Taylor's method picks its order from
+/// ([`crate::TaylorSeries::series_work`]). Taylor's method picks its order from
 /// it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SeriesWork {

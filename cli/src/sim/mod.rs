@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use clap::Args;
 use dalembert::runtime::prelude::*;
-use dalembert::runtime::simulate::{SimError, Simulator};
+use dalembert::runtime::simulate::{SeriesRoom, SimError, Simulator};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::plot::plot;
@@ -72,7 +72,7 @@ pub fn simulate(args: &SimulateArgs) -> Result<bool, String> {
     struct Simulate<'a>(&'a SimulateArgs);
     impl WithModel for Simulate<'_> {
         type Output = bool;
-        fn with<M: Surfaces<N>, const N: usize>(
+        fn with<M: TaylorSeries<N>, const N: usize>(
             self,
             model: M,
             derived: &[String],
@@ -101,7 +101,7 @@ fn checked_spacing(args: &SimulateArgs) -> Result<f64, String> {
 }
 
 /// Simulates `model` (whose derived parameters are `derived`) as `args` say.
-fn run<M: Surfaces<N>, const N: usize>(
+fn run<M: TaylorSeries<N>, const N: usize>(
     args: &SimulateArgs,
     model: M,
     derived: &[String],
@@ -120,7 +120,8 @@ fn run<M: Surfaces<N>, const N: usize>(
         ));
     }
     let named = |e: SimError<M::Wall>| e.map_wall(|w| model.wall_name(w)).to_string();
-    let mut sim = Simulator::new(&model, start, settings(&args.run)).map_err(named)?;
+    let mut room = SeriesRoom::new(&model);
+    let mut sim = Simulator::with_series(&mut room, start, settings(&args.run)).map_err(named)?;
     std::fs::create_dir_all(&args.out)
         .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
     let csv = args.out.join(format!("{}.csv", model.name()));

@@ -129,6 +129,13 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
         }
         None => (quote! { type SeriesScratch = (); }, TokenStream::new()),
     };
+    let series_impl = quote! {
+        #no_walls
+        impl ::dalembert_runtime::TaylorSeries<#nl> for #ty {
+            #motion_series
+            #surface_series
+        }
+    };
     let bound = |what: &str| {
         let arms = d.derivation.walls.iter().zip(&variants).map(|(w, v)| {
             let f = format_ident!("{}_{what}_bounds", w.name);
@@ -145,12 +152,10 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
             fn initial_velocities(&self) -> [f64; #nl] { self.initial_state().1 }
             fn initial_velocities_given(&self) -> [bool; #nl] { Self::VELOCITIES_GIVEN }
             #( #dynamics )*
-            #motion_series
         }
         #no_walls
         impl ::dalembert_runtime::Surfaces<#nl> for #ty {
             #( #surfaces )*
-            #surface_series
             #[inline]
             fn surface_bounds(&self, wall: Wall, q: &[#interval; #nl]) -> Option<#interval> {
                 #surface_bounds
@@ -160,6 +165,7 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
                 #normal_bounds
             }
         }
+        #series_impl
     }
 }
 

@@ -17,7 +17,7 @@ use std::cell::RefCell;
 
 use dalembert_runtime::interval::Interval;
 use dalembert_runtime::taylor::{Coefficients, MAX_ORDER, Series, SeriesWork};
-use dalembert_runtime::{__private, Dynamics, Model, Rows, Surfaces, Values, Walls};
+use dalembert_runtime::{__private, Dynamics, Model, Rows, Surfaces, TaylorSeries, Values, Walls};
 
 use crate::derive::{Derivation, Function};
 use crate::ir::Kind;
@@ -483,26 +483,6 @@ impl<const N: usize> Dynamics<N> for Interpreted<N> {
         let c = self.accelerations_parameter_tangent.as_ref()?;
         (dp.len() == self.np()).then(|| self.tangent(c, &[q, v, dp]))
     }
-    /// The interpreter keeps its room itself (`SeriesPrograms::workspace`,
-    /// sized by the first call and reused by every simulator after it).
-    type SeriesScratch = ();
-    fn taylor_series(&self, series: &mut Series<N>, _: &mut (), order: usize) -> bool {
-        let Some(sp) = &self.series else {
-            return false;
-        };
-        let q: [f64; N] = std::array::from_fn(|i| series.q[i][0]);
-        let v: [f64; N] = std::array::from_fn(|i| series.v[i][0]);
-        let order = order.min(MAX_ORDER);
-        let (motion, numbers) = &sp.motion;
-        let e = &mut *sp.workspace.borrow_mut();
-        motion.motion_into(e, numbers, &q, &v, order);
-        for i in 0..N {
-            series.q[i] = e.q[i];
-            series.v[i] = e.v[i];
-        }
-        series.order = order;
-        true
-    }
 }
 
 impl<const N: usize> Surfaces<N> for Interpreted<N> {
@@ -539,6 +519,29 @@ impl<const N: usize> Surfaces<N> for Interpreted<N> {
         Some(f.eval_bounds(self.np(), q, |o| {
             core::array::from_fn(|i| o.get(i).copied().unwrap_or(Interval::point(0.0)))
         }))
+    }
+}
+
+impl<const N: usize> TaylorSeries<N> for Interpreted<N> {
+    /// The interpreter keeps its room itself (`SeriesPrograms::workspace`,
+    /// sized by the first call and reused by every simulator after it).
+    type SeriesScratch = ();
+    fn taylor_series(&self, series: &mut Series<N>, _: &mut (), order: usize) -> bool {
+        let Some(sp) = &self.series else {
+            return false;
+        };
+        let q: [f64; N] = std::array::from_fn(|i| series.q[i][0]);
+        let v: [f64; N] = std::array::from_fn(|i| series.v[i][0]);
+        let order = order.min(MAX_ORDER);
+        let (motion, numbers) = &sp.motion;
+        let e = &mut *sp.workspace.borrow_mut();
+        motion.motion_into(e, numbers, &q, &v, order);
+        for i in 0..N {
+            series.q[i] = e.q[i];
+            series.v[i] = e.v[i];
+        }
+        series.order = order;
+        true
     }
     fn surface_series(
         &self,

@@ -45,7 +45,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
                 let y = dense.at(tau / h, *h);
                 (y.q, y.v)
             }
-            None => self.series.state(tau),
+            None => self.series()?.state(tau),
         };
         Some(State { t, q, v })
     }

@@ -24,9 +24,9 @@
 //!
 //! With [`Integrator::Taylor`] the step is instead the truncated Taylor
 //! series of the motion, from the model's generated series
-//! ([`crate::Dynamics::taylor_series`]), of the order and length the
+//! ([`crate::TaylorSeries::taylor_series`]), of the order and length the
 //! tolerance asks for (Jorba & Zou); each wall's f along the step is a
-//! polynomial too ([`Surfaces::surface_series`]), and its first descending
+//! polynomial too ([`crate::TaylorSeries::surface_series`]), and its first descending
 //! root on the step is found on that polynomial to rounding, so a collision
 //! needs no further steps. A wall's series bounds the step as the motion's
 //! does (a wall through a square root or a quotient may converge on a far
@@ -67,6 +67,7 @@ mod path;
 mod phase;
 mod projection;
 mod return_map;
+mod room;
 mod roots;
 mod series;
 pub mod thresholds;
@@ -78,17 +79,18 @@ pub use projection::{
     StartRule, admissible, onto_holonomic, residual, starting_velocity, tangent_direction,
 };
 pub use return_map::{Return, ReturnError, Section, return_map};
+pub use room::SeriesRoom;
 pub use types::{Collision, Residual, Settings, SimError, State, Stats, Step};
 pub use variational::{ParameterSensitivity, Variational, VariationalError};
 
 use crate::Surfaces;
 use crate::dynamics::{accelerations, qdd};
-use crate::taylor::Series;
 use dense_output::LastStep;
 use events::Scan;
 use integrator::{Engine, Method, RungeKutta};
 use path::RkStep;
 use phase::{Phase, norm};
+use room::Room;
 use thresholds::{ADMISSIBLE, MAX_WALLS, ON_WALL, TAYLOR_REACH};
 
 /// The hybrid simulator for a model with coordinates (`Q = N`).
@@ -114,9 +116,9 @@ pub struct Simulator<'m, M: Surfaces<N>, const N: usize> {
     low_order_first: bool,
     low_order: usize,
     /// Taylor's method: the series of the current step, a buffer reused
-    /// by every step, and the room for the model's intermediate series.
-    series: Series<N>,
-    scratch: M::SeriesScratch,
+    /// by every step, and the room for the model's intermediate series
+    /// (only in a simulator built by [`Simulator::with_series`]).
+    room: Option<&'m mut dyn Room<N>>,
     /// The last step's motion ([`Simulator::state_at`]).
     last: Option<LastStep<N>>,
     stats: Stats,
@@ -149,11 +151,39 @@ fn derivative<M: Surfaces<N>, const N: usize>(
 }
 
 impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
-    /// A simulator from `start`. The state must be admissible (A q̇ = 0 and
+    /// A simulator from `start`, for the Runge–Kutta methods (Taylor's
+    /// method needs [`Simulator::with_series`]: with it this is
+    /// [`SimError::NoSeries`]). The state must be admissible (A q̇ = 0 and
     /// h(q) = 0 to within [`thresholds::ADMISSIBLE`] relative) and in f ≥ 0
     /// for every wall; on a wall (f = 0) it must be moving away from it.
     pub fn new(
         model: &'m M,
+        start: State<N>,
+        settings: Settings,
+    ) -> Result<Self, SimError<M::Wall>> {
+        Self::build(model, None, start, settings)
+    }
+
+    /// A simulator from `start` for any of the methods, Taylor's too, with
+    /// `room` for the series of its steps (see [`Simulator::new`] for what
+    /// `start` must be). The room is used only by Taylor's method, and is
+    /// the only place its buffers live.
+    pub fn with_series<'r>(
+        room: &'m mut SeriesRoom<'r, M, N>,
+        start: State<N>,
+        settings: Settings,
+    ) -> Result<Self, SimError<M::Wall>>
+    where
+        M: crate::TaylorSeries<N>,
+        'r: 'm,
+    {
+        let model = room.model();
+        Self::build(model, Some(room as &mut dyn Room<N>), start, settings)
+    }
+
+    fn build(
+        model: &'m M,
+        mut room: Option<&'m mut dyn Room<N>>,
         start: State<N>,
         settings: Settings,
     ) -> Result<Self, SimError<M::Wall>> {
@@ -197,13 +227,12 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
         let mut stats = Stats::default();
         let f0 = derivative(model, &mut stats, start.t, &y)?;
         let mut engine = settings.integrator.engine();
-        let (mut series, mut scratch) =
-            (Series::at(&start.q, &start.v), M::SeriesScratch::default());
         let (proposal, low_order) = match &mut engine {
             Engine::RungeKutta(m) => (m.initial_step(&y, &f0), 0),
             Engine::Taylor(t) => {
-                series::offered(model, &mut series, &mut scratch)?;
-                *t = t.fitted(model.series_work(), N, model.walls().len());
+                let room = room.as_deref_mut().ok_or(SimError::NoSeries)?;
+                series::offered(room, &start, model.walls().len())?;
+                *t = t.fitted(room.work(), N, model.walls().len());
                 (f64::INFINITY, Taylor::FIRST_TRIAL_ORDER)
             }
         };
@@ -219,8 +248,7 @@ impl<'m, M: Surfaces<N>, const N: usize> Simulator<'m, M, N> {
             last_collision: None,
             low_order_first: true,
             low_order,
-            series,
-            scratch,
+            room,
             last: None,
             stats,
         })

@@ -19,11 +19,11 @@
 //! ∇fᵀ DΠ = 0.
 
 use super::variational::{Variational, VariationalError};
-use super::{Settings, SimError, Simulator, State};
-use crate::Surfaces;
+use super::{SeriesRoom, Settings, SimError, Simulator, State};
 use crate::dynamics::{DynamicsError, qdd};
 use crate::linalg;
 use crate::saltation::StateMatrix;
+use crate::{Surfaces, TaylorSeries};
 
 /// Where and how long to look for returns.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -71,15 +71,18 @@ pub enum ReturnError<W> {
 /// Π(`start`) for `section`, run with `settings`; with `jacobian =
 /// Some(rtol)` also DΠ, Φ integrated at relative tolerance `rtol`. The
 /// start must be a state the simulator accepts (on the section: on the
-/// wall, moving away).
-pub fn return_map<M: Surfaces<N>, const N: usize>(
+/// wall, moving away). Any method may step, Taylor's too: the room for its
+/// series is on this function's stack.
+pub fn return_map<M: TaylorSeries<N>, const N: usize>(
     model: &M,
     start: State<N>,
     section: &Section<M::Wall>,
     settings: Settings,
     jacobian: Option<f64>,
 ) -> Result<Return<N>, ReturnError<M::Wall>> {
-    let mut sim = Simulator::new(model, start, settings).map_err(ReturnError::Simulation)?;
+    let mut room = SeriesRoom::new(model);
+    let mut sim =
+        Simulator::with_series(&mut room, start, settings).map_err(ReturnError::Simulation)?;
     let mut phi = jacobian.map(Variational::<N>::new);
     let t_end = start.t + section.t_max;
     let mut met = 0;

@@ -11,6 +11,7 @@ use super::events::Scan;
 use super::integrator::{Plan, Reach};
 use super::path::SeriesStep;
 use super::phase::Phase;
+use super::room::Room;
 use super::roots::first_root;
 use super::thresholds::{
     LONGEST_SERIES_STEP, ON_WALL_ULPS, POLISH_STEPS, SERIES_CHECK, TAYLOR_REACH, step_too_small,
@@ -20,24 +21,16 @@ use crate::dynamics::DynamicsError;
 use crate::taylor::{CAPACITY, Coefficients, Series, degree, eval_with_derivative};
 use crate::{Surfaces, libm};
 
-/// Whether `m` has the series Taylor's method needs (of the motion and of
-/// every wall's f), tried from the state at order 0 of `s` in the
-/// simulator's own series and room.
-pub(super) fn offered<M: Surfaces<N>, const N: usize>(
-    m: &M,
-    s: &mut Series<N>,
-    scratch: &mut M::SeriesScratch,
-) -> Result<(), SimError<M::Wall>> {
-    if !m.taylor_series(s, scratch, 1) {
-        return Err(SimError::NoSeries);
-    }
+/// Whether the model of `room` has the series Taylor's method needs (of
+/// the motion and of each of its `walls` walls' f), tried from `start`.
+pub(super) fn offered<W, const N: usize>(
+    room: &mut dyn Room<N>,
+    start: &State<N>,
+    walls: usize,
+) -> Result<(), SimError<W>> {
     let mut f = [0.0; CAPACITY];
-    for &wall in m.walls() {
-        if !m.surface_series(wall, s, scratch, &mut f) {
-            return Err(SimError::NoSeries);
-        }
-    }
-    Ok(())
+    let all = room.expand(&start.q, &start.v, 1) && (0..walls).all(|k| room.surface(k, &mut f));
+    all.then_some(()).ok_or(SimError::NoSeries)
 }
 
 impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
@@ -71,14 +64,14 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         let left = (t_end - t0) - self.t_low;
         let tried = self.low_order_first && self.low_order < method.order;
         if tried {
-            let mut limit = self.series(method, self.low_order, left)?;
+            let mut limit = self.expand(method, self.low_order, left)?;
             let found = self.first_collision(&mut limit)?;
             if found.is_some() || limit.length(t0)? >= left {
                 self.stats.low_order_steps += 1;
                 return self.take(&mut limit, t_end, found);
             }
         }
-        let mut limit = self.series(method, method.order, left)?;
+        let mut limit = self.expand(method, method.order, left)?;
         let found = self.first_collision(&mut limit)?;
         let h = limit.length(t0)?;
         // The Runge–Kutta steps' rule (a fixed order far below the
@@ -92,16 +85,31 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             // a trial at the next landing.)
             let reach = found.map_or(h, |f| f.tau);
             self.low_order = (self.low_order + 1..method.order)
-                .find(|&p| method.covers(&method.reach(&self.series, p), reach))
+                .find(|&p| {
+                    self.series()
+                        .is_some_and(|s| method.covers(&method.reach(s, p), reach))
+                })
                 .unwrap_or(method.order);
         }
         self.low_order_first = found.is_some();
         self.take(&mut limit, t_end, found)
     }
 
+    /// The series of the step last expanded (`None` only in a simulator
+    /// without room for series, which never takes a step of Taylor's
+    /// method).
+    pub(super) fn series(&self) -> Option<&Series<N>> {
+        self.room.as_deref().map(|r| r.series())
+    }
+
+    /// The state (q, q̇) at τ on the step's series.
+    fn series_state(&self, tau: f64) -> Result<QV<N>, SimError<M::Wall>> {
+        Ok(self.series().ok_or(SimError::NoSeries)?.state(tau))
+    }
+
     /// The series of the motion from the current state to `order`, into
-    /// `self.series`, and the step it allows (at most `left`).
-    fn series<'p>(
+    /// the room, and the step it allows (at most `left`).
+    fn expand<'p>(
         &mut self,
         method: &'p Plan,
         order: usize,
@@ -114,11 +122,11 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
                 step: left,
             });
         }
-        let s = &mut self.series;
-        s.restart(&self.state.q, &self.state.v);
-        if !self.model.taylor_series(s, &mut self.scratch, order) {
+        let room = self.room.as_deref_mut().ok_or(SimError::NoSeries)?;
+        if !room.expand(&self.state.q, &self.state.v, order) {
             return Err(SimError::NoSeries);
         }
+        let s = room.series();
         self.stats.evaluations += 1;
         self.stats.series_orders += order as u64;
         // Non-finite coefficients are caught where the step is evaluated
@@ -134,27 +142,28 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     }
 
     /// The first collision on the step `limit` allows along
-    /// `self.series`; grazing and simultaneous contacts as errors. Each
+    /// the room's series; grazing and simultaneous contacts as errors. Each
     /// wall's series also bounds the step (its roots are searched only
     /// where it converges: [`Plan::tighten`]), so a wall met beyond where a
     /// later wall's series converges is not on the step.
     fn first_collision(&mut self, limit: &mut Limit) -> Result<Option<Found>, SimError<M::Wall>> {
-        let (t0, m, s) = (self.state.t, self.model, &self.series);
-        let scratch = &mut self.scratch;
+        let (t0, m) = (self.state.t, self.model);
+        let room = self.room.as_deref_mut().ok_or(SimError::NoSeries)?;
+        let order = room.series().order;
         // The earliest and the next event: (wall, τ, what, the step's
         // bounds then): what is Ok(f's scale) for a collision, Err(normal
         // velocity) for a departure that turns back first.
         let mut best: Option<(usize, f64, Result<f64, f64>, Reach)> = None;
         let mut second: Option<(usize, f64, Reach)> = None;
         let mut f = [0.0; CAPACITY];
-        for (k, &wall) in m.walls().iter().enumerate() {
-            m.surface_series(wall, s, scratch, &mut f);
+        for k in 0..m.walls().len() {
+            room.surface(k, &mut f);
             limit.tighten(&f);
             let departing = self.departing & (1 << k) != 0;
-            let (tau, what) = match limit.first_root(&f, s.order, departing, t0)? {
+            let (tau, what) = match limit.first_root(&f, order, departing, t0)? {
                 Ok(Some(tau)) => (tau, Ok(libm::fabs(f[0]).max(1.0))),
                 Ok(None) => continue,
-                Err(top) => (top, Err(eval_with_derivative(&f, s.order, top).1)),
+                Err(top) => (top, Err(eval_with_derivative(&f, order, top).1)),
             };
             let reach = limit.reach;
             match best {
@@ -247,10 +256,10 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
     /// `q1` is q at τ = `end`; the step starts at `self.state`.
     fn clear_before(&self, end: f64, q1: &[f64; N]) -> bool {
         let m = self.model;
-        let path = SeriesStep {
-            series: &self.series,
-            tau: end,
+        let Some(series) = self.series() else {
+            return false;
         };
+        let path = SeriesStep { series, tau: end };
         let y0 = &self.state;
         m.walls().iter().enumerate().all(|(k, &wall)| {
             let f0 = m.surface(wall, &y0.q);
@@ -291,7 +300,9 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             if !(next > 0.0 && libm::fabs(next - start) <= reach) || next == tau {
                 break;
             }
-            let candidate = self.series.state(next);
+            let Ok(candidate) = self.series_state(next) else {
+                break;
+            };
             let f_next = m.surface(wall, &candidate.0);
             if f_next.is_nan() || libm::fabs(f_next) >= libm::fabs(f) {
                 break;
@@ -301,7 +312,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         (tau, y)
     }
 
-    /// The step along `self.series`: to the collision `found`, else as
+    /// The step along the room's series: to the collision `found`, else as
     /// far as `limit` allows (to `t_end` if that reaches it).
     ///
     /// The walls are checked where the step ends ([`Simulator::agrees`]);
@@ -321,7 +332,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             Some(c) => c.tau,
             None => limit.length(t0)?,
         };
-        let mut y = finite(self.series.state(end), t0)?;
+        let mut y = finite(self.series_state(end)?, t0)?;
         let agreed = self
             .agrees(found, &y.0, &y.1, limit.plan.method.tolerance)
             .filter(|_| self.clear_before(end, &y.0));
@@ -337,7 +348,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             self.stats.direct_crossings += 1;
             let h = limit.length(t0)?;
             let path = SeriesStep {
-                series: &self.series,
+                series: self.series().ok_or(SimError::NoSeries)?,
                 tau: h,
             };
             (found, end) = match self.scan(&path, t0, h)? {
@@ -358,7 +369,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
                 // ends before the interval instead.
                 Scan::Unresolved(u) => (None, u.shorter(h)),
             };
-            y = finite(self.series.state(end), t0)?;
+            y = finite(self.series_state(end)?, t0)?;
         }
         let (q, v) = y;
         self.stats.steps += 1;
@@ -412,6 +423,9 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         (sum, low - (sum - hi))
     }
 }
+
+/// A state (q, q̇) on a step's series.
+type QV<const N: usize> = ([f64; N], [f64; N]);
 
 /// A collision found on a step of Taylor's method: the wall's index, τ
 /// from the step's start, and the scale of its f there, max(1, |f₀|).
@@ -501,10 +515,7 @@ impl Limit<'_> {
 
 /// The state on the step's polynomial, if finite (a non-finite series
 /// gives a non-finite state at every τ > 0).
-fn finite<W, const N: usize>(
-    (q, v): ([f64; N], [f64; N]),
-    t0: f64,
-) -> Result<([f64; N], [f64; N]), SimError<W>> {
+fn finite<W, const N: usize>((q, v): QV<N>, t0: f64) -> Result<QV<N>, SimError<W>> {
     if q.iter().chain(&v).all(|x| x.is_finite()) {
         Ok((q, v))
     } else {

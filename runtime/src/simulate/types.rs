@@ -217,9 +217,11 @@ pub enum SimError<W> {
     /// [`super::Taylor::valid`]'s ranges, a grazing or simultaneity
     /// threshold out of range.
     BadSettings,
-    /// Taylor's method was asked for, but the model has no Taylor series
-    /// of its motion or of a wall's f (generated models with coordinates
-    /// have them; a hand-written model may not).
+    /// Taylor's method was asked for, but the simulator has no room for
+    /// series (it was built with [`super::Simulator::new`]; use
+    /// [`super::Simulator::with_series`]), or the model has no Taylor
+    /// series of its motion or of a wall's f (generated models with
+    /// coordinates have them; a hand-written model may not).
     NoSeries,
     /// The model has more walls than the simulator tracks
     /// ([`super::thresholds::MAX_WALLS`]).
@@ -318,7 +320,7 @@ impl<W: core::fmt::Debug> core::fmt::Display for SimError<W> {
             ),
             SimError::NoSeries => write!(
                 f,
-                "Taylor's method needs the model's Taylor series (Dynamics::taylor_series, Surfaces::surface_series), which this model does not have"
+                "Taylor's method needs the model's Taylor series (TaylorSeries::taylor_series and surface_series) and a simulator built with Simulator::with_series to hold them; this one has none"
             ),
             SimError::TooManyWalls { walls } => write!(
                 f,

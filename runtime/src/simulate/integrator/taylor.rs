@@ -1,5 +1,5 @@
 //! Taylor's method: the step is the truncated Taylor series of the motion
-//! itself (the model's generated [`crate::Dynamics::taylor_series`]), its
+//! itself (the model's generated [`crate::TaylorSeries::taylor_series`]), its
 //! order and length chosen from the tolerance as Jorba & Zou propose
 //! (*A software package for the numerical integration of ODEs by means of
 //! high-order Taylor methods*, Exp. Math. 14, 2005, §3.2), and the step's
