@@ -210,6 +210,9 @@ fn bounce_closed_form(t: f64, m: u32, g: f64, h: f64) -> [f64; 2] {
 /// derivatives by p at the same t and number of bounces (Richardson
 /// differences of the formula). The row before a bounce has the derivative
 /// of the flight before it, the row after it that of the flight after it.
+/// The row before the n-th bounce, at t = (2n − 1)v/g, v = √(2gh), also has
+/// the instant's derivatives, (2n − 1)/v by h and −(2n − 1)v/(2g²) by g;
+/// that cell is empty on every other row.
 #[test]
 fn by_parameters_of_a_bouncing_point_follow_its_closed_form() {
     let dir = out_dir("sensitivity_by_parameters");
@@ -227,15 +230,16 @@ fn by_parameters_of_a_bouncing_point_follow_its_closed_form() {
         assert!(stdout.contains("  ∂/∂h at t = 3: y "), "{stdout}");
         assert_eq!(
             header,
-            "t,y,y_dot,energy,residual_velocity,residual_position,collision,dy/dh,dy_dot/dh,dy/dg,dy_dot/dg"
+            "t,y,y_dot,energy,residual_velocity,residual_position,collision,dy/dh,dy_dot/dh,dt_collision/dh,dy/dg,dy_dot/dg,dt_collision/dg"
         );
+        let v = (2.0 * g * h).sqrt();
         let (mut bounces, mut rows) = (0, 0);
         for cells in &lines {
             let at = |k: usize| cells[k].parse::<f64>().unwrap();
             let t = at(0);
             let by_h = derivative(&|h| bounce_closed_form(t, bounces, g, h), h);
             let by_g = derivative(&|g| bounce_closed_form(t, bounces, g, h), g);
-            for (got, want, what) in [([at(7), at(8)], by_h, "h"), ([at(9), at(10)], by_g, "g")] {
+            for (got, want, what) in [([at(7), at(8)], by_h, "h"), ([at(10), at(11)], by_g, "g")] {
                 for i in 0..2 {
                     assert!(
                         (got[i] - want[i]).abs() <= 1e-7 * want[i].abs().max(1.0),
@@ -243,7 +247,24 @@ fn by_parameters_of_a_bouncing_point_follow_its_closed_form() {
                     );
                 }
             }
-            bounces += u32::from(cells[6] == "floor");
+            if cells[6] == "floor" {
+                let n = f64::from(2 * bounces + 1);
+                for (got, want, what) in
+                    [(at(9), n / v, "h"), (at(12), -n * v / (2.0 * g * g), "g")]
+                {
+                    assert!(
+                        (got - want).abs() <= 1e-9 * want.abs(),
+                        "{method}, bounce {}: ∂t*/∂{what} {got}, not {want}",
+                        bounces + 1
+                    );
+                }
+                bounces += 1;
+            } else {
+                assert!(
+                    cells[9].is_empty() && cells[12].is_empty(),
+                    "{method}: {cells:?}"
+                );
+            }
             rows += 1;
         }
         assert_eq!(bounces, 3, "{method}");
@@ -268,9 +289,10 @@ fn differences_of_runs(end: impl Fn(f64) -> Vec<f64>) -> Vec<f64> {
 /// `--by` on the hardest kind of model the CLI takes: a Chaplygin sleigh
 /// (a constraint that moves with c, which the start's completed velocity
 /// follows) in an elliptic rink written through a square root (whose edge
-/// moves with a). The end row's columns against Richardson differences of
-/// the end states of whole runs with `--set c=…` or `--set a=…`, through
-/// the same collisions.
+/// moves with a). The end row's columns, and each collision row's
+/// `dt_collision/dp`, against Richardson differences of the end states and
+/// the collision instants of whole runs with `--set c=…` or `--set a=…`,
+/// through the same collisions.
 #[test]
 fn by_parameters_on_a_square_root_rink_match_differences_of_whole_runs() {
     let file = concat!(
@@ -281,8 +303,9 @@ fn by_parameters_on_a_square_root_rink_match_differences_of_whole_runs() {
     let tight = [
         "--rtol", "1e-12", "--atol", "1e-14", "--t-end", "6", "--every", "0.5",
     ];
-    // The last row and the number of collisions of a run with `extra`.
-    let run = |extra: &[&str]| -> (Vec<f64>, usize) {
+    // The last row's numbers, the number of collisions, and each collision
+    // row's cells, of a run with `extra`.
+    let run = |extra: &[&str]| -> (Vec<f64>, usize, Vec<Vec<String>>) {
         let mut args = vec!["simulate", file, "--out", &dir];
         args.extend(tight);
         args.extend(extra);
@@ -305,27 +328,44 @@ fn by_parameters_on_a_square_root_rink_match_differences_of_whole_runs() {
             .filter(|c| !c.is_empty())
             .filter_map(|c| c.parse().ok())
             .collect();
-        (cells, collisions)
+        // (t, 3 coordinates, 3 velocities, energy, 2 residuals, then the
+        // wall met at 10.)
+        let met = (csv.lines().skip(1))
+            .map(|l| l.split(',').map(str::to_string).collect::<Vec<_>>())
+            .filter(|c| !c[10].is_empty())
+            .collect();
+        (cells, collisions, met)
     };
-    let (followed, collisions) = run(&["--by", "c,a"]);
+    let (followed, collisions, met) = run(&["--by", "c,a"]);
     assert!(collisions >= 3, "{collisions} collisions");
+    assert_eq!(met.len(), collisions);
     // t, 3 coordinates, 3 velocities, energy, 2 residuals, then 6 columns
-    // by c and 6 by a.
+    // by c and 6 by a (the instants' columns are empty here).
     assert_eq!(followed.len(), 10 + 12);
     for (k, (p, p0)) in [("c", 0.1f64), ("a", 1.2)].into_iter().enumerate() {
+        // The end state, then every collision instant.
         let end = |d: f64| -> Vec<f64> {
             let set = format!("{p}={}", p0 + d);
-            let (row, c) = run(&["--set", &set]);
+            let (row, c, met) = run(&["--set", &set]);
             assert_eq!(c, collisions, "{p} moved by {d}: other collisions");
-            row[1..7].to_vec()
+            let instants = met.iter().map(|cells| cells[0].parse::<f64>().unwrap());
+            row[1..7].iter().copied().chain(instants).collect()
         };
         let want = differences_of_runs(end);
         let got = &followed[10 + 6 * k..16 + 6 * k];
-        let size = want.iter().fold(1.0f64, |a, x| a.max(x.abs()));
+        let size = want[..6].iter().fold(1.0f64, |a, x| a.max(x.abs()));
         for (g, w) in got.iter().zip(&want) {
             assert!(
                 (g - w).abs() <= 1e-6 * size,
                 "∂/∂{p}: followed {got:?}, differences {want:?}"
+            );
+        }
+        // dt_collision/dp, after the 6 columns by p.
+        for (n, (cells, w)) in met.iter().zip(&want[6..]).enumerate() {
+            let g: f64 = cells[17 + 7 * k].parse().unwrap();
+            assert!(
+                (g - w).abs() <= 1e-6 * w.abs().max(1.0),
+                "∂t*/∂{p} of collision {n}: followed {g}, differences {w}"
             );
         }
     }
@@ -461,6 +501,7 @@ fn by_a_small_parameter_differentiates_its_start_in_its_own_scale() {
     let csv = std::fs::read_to_string(PathBuf::from(&dir).join("thrown.csv")).unwrap();
     let first: Vec<f64> = (csv.lines().nth(1).unwrap().split(','))
         .skip(7)
+        .take(2)
         .map(|c| c.parse().unwrap())
         .collect();
     assert!(

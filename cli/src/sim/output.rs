@@ -110,8 +110,9 @@ impl<'m, const N: usize> Output<'m, N> {
             .map_err(|e| format!("cannot write {}: {e}", self.path.display()))
     }
 
-    /// Writes the row `r` and its `extra` columns (as many as the header's).
-    pub(super) fn push(&mut self, r: Row<'m, N>, extra: &[f64]) -> Result<(), String> {
+    /// Writes the row `r` and its `extra` columns (as many as the header's;
+    /// `None` leaves a cell empty).
+    pub(super) fn push(&mut self, r: Row<'m, N>, extra: &[Option<f64>]) -> Result<(), String> {
         if self.written >= MAX_ROWS {
             return Err(format!(
                 "stopped at t = {}: the run has written {MAX_ROWS} rows to {} (collisions count as rows), the most a run may write; raise --every or shorten --t-end",
@@ -131,9 +132,11 @@ impl<'m, const N: usize> Output<'m, N> {
         }
         line.push(b',');
         line.extend_from_slice(r.event.unwrap_or("").as_bytes());
-        for &x in extra {
+        for x in extra {
             line.push(b',');
-            line.extend_from_slice(number.format(x).as_bytes());
+            if let Some(x) = x {
+                line.extend_from_slice(number.format(*x).as_bytes());
+            }
         }
         line.push(b'\n');
         self.write(&line)?;

@@ -37,6 +37,7 @@ impl<'p, const N: usize> Followed<'p, N> {
         let state_names = state_names(model);
         for p in by {
             names.extend(state_names.iter().map(|a| format!("d{a}/d{}", p.name)));
+            names.push(format!("dt_collision/d{}", p.name));
         }
         Self {
             phi: (phi || columns.is_some()).then(|| Variational::new(rtol)),
@@ -75,8 +76,11 @@ impl<'p, const N: usize> Followed<'p, N> {
         Ok(())
     }
 
-    /// The columns' values now, or just before the last step's collision.
-    pub(super) fn values(&self, before: bool) -> Vec<f64> {
+    /// The columns' values now, or just before the last step's collision
+    /// (`before`). A derivative of the collision instant by a parameter
+    /// is on the row before its collision; on the other rows its cell is
+    /// empty (`None`).
+    pub(super) fn values(&self, before: bool) -> Vec<Option<f64>> {
         let mut out = Vec::with_capacity(self.names.len());
         if let (Some(columns), Some(phi)) = (&self.columns, &self.phi) {
             let m = if before {
@@ -84,7 +88,7 @@ impl<'p, const N: usize> Followed<'p, N> {
             } else {
                 phi.matrix()
             };
-            out.extend(columns.values(m));
+            out.extend(columns.values(m).into_iter().map(Some));
         }
         for (_, s) in &self.by {
             let (dq, dv) = if before {
@@ -92,7 +96,8 @@ impl<'p, const N: usize> Followed<'p, N> {
             } else {
                 s.value()
             };
-            out.extend(dq.iter().chain(&dv));
+            out.extend(dq.iter().chain(&dv).copied().map(Some));
+            out.push(s.collision_shift().filter(|_| before));
         }
         out
     }
