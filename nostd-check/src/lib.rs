@@ -16,7 +16,7 @@
 
 use dalembert::models::{BallBounce, BallFloor, Chain4, PendulumWall};
 use dalembert::runtime::prelude::*;
-use dalembert::runtime::simulate::{Settings, Simulator, State};
+use dalembert::runtime::simulate::{Integrator, SeriesRoom, Settings, Simulator, State, Taylor};
 
 #[panic_handler]
 fn panic(_: &core::panic::PanicInfo) -> ! {
@@ -60,4 +60,29 @@ pub extern "C" fn dalembert_nostd_simulate() -> i64 {
     let a = run(&BallBounce::default());
     let b = run(&PendulumWall::default());
     if a < 0 || b < 0 { -1 } else { a + b }
+}
+
+/// Taylor's method, its series and scratch in a room on the stack: the
+/// ball through a second of flight; the number of collisions, or −1 on a
+/// simulation error.
+#[unsafe(no_mangle)]
+pub extern "C" fn dalembert_nostd_taylor() -> i64 {
+    let ball = BallBounce::default();
+    let start = State {
+        t: 0.0,
+        q: ball.initial_coordinates(),
+        v: ball.initial_velocities(),
+    };
+    let settings = Settings {
+        integrator: Integrator::Taylor(Taylor::default()),
+        ..Settings::default()
+    };
+    let mut room = SeriesRoom::new(&ball);
+    let Ok(mut sim) = Simulator::with_series(&mut room, start, settings) else {
+        return -1;
+    };
+    match sim.run(1.0, |_| true) {
+        Ok(stats) => stats.collisions as i64,
+        Err(_) => -1,
+    }
 }
