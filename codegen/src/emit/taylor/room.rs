@@ -31,7 +31,7 @@ pub(in crate::emit) fn scratch_struct(d: &Ctx) -> TokenStream {
     let lanes = most(&|t| pairs::plan(t).lanes);
     let doc = quote! {
         /// Room for the intermediate series of `motion_series` and the
-        /// walls' `surface_series` (`Dynamics::SeriesScratch`), kept by
+        /// walls' `surface_series` (`TaylorSeries::SeriesScratch`), kept by
         /// the caller from one call to the next: a call writes each
         /// coefficient before it reads it, so nothing needs clearing
         /// between calls.
