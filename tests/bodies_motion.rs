@@ -15,7 +15,9 @@ mod common;
 
 use common::derived;
 use dalembert::runtime::prelude::*;
-use dalembert::runtime::simulate::{Simulator, State};
+use dalembert::runtime::simulate::{
+    Simulator, StartRule, State, starting_velocity, starting_velocity_with,
+};
 use dalembert_codegen::interpret::Interpreted;
 
 /// A bob on a spring (k, rest length L) from a fixed point H above the
@@ -219,6 +221,74 @@ fn attitude_conventions_give_the_same_motion() {
             }
         }
     }
+}
+
+/// Chaplygin's ball started as a user states it: its attitude and its
+/// angular velocity by the bodies layer's names (`ball_wx`, `ball_wy`,
+/// `ball_wz` in `[initial]`, values in the fixed frame), the centre's
+/// velocity and the attitude's rates left out. The velocity the runtime
+/// completes from those rates and the constraints is, in every
+/// convention, the one [`chaplygin_start`] converts by its own formulas.
+fn start_by_rates<const N: usize>(convention: &str) {
+    let (q, want) = chaplygin_start(convention, 0.5);
+    let w = [0.7, -0.5, 1.3];
+    let names: &[&str] = match convention {
+        "quaternion" => &["x", "y", "e0", "e1", "e2", "e3"],
+        _ => &["x", "y", "a1", "a2", "a3"],
+    };
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut text =
+        std::fs::read_to_string(root.join(format!("tests/bodies/chaplygin_{convention}.toml")))
+            .unwrap();
+    text.push_str("\n[initial]\n");
+    for (name, value) in names.iter().zip(&q) {
+        text.push_str(&format!("{name} = \"{value:?}\"\n"));
+    }
+    for (axis, value) in ["x", "y", "z"].iter().zip(w) {
+        text.push_str(&format!("ball_w{axis} = \"{value:?}\"\n"));
+    }
+    let file = std::env::temp_dir().join(format!(
+        "dalembert_start_by_rates_{convention}_{}.toml",
+        std::process::id()
+    ));
+    std::fs::write(&file, &text).unwrap();
+    let d = dalembert_codegen::derive(&file).unwrap_or_else(|e| panic!("{convention}: {e}"));
+    std::fs::remove_file(&file).unwrap();
+    let m = Interpreted::<N>::new(&d).unwrap();
+    assert_eq!(m.start_rate_names(), ["ball_wx", "ball_wy", "ball_wz"]);
+    assert_eq!(m.start_values().as_slice(), w);
+    let q = m.initial_coordinates();
+    let (v, rule) = starting_velocity(
+        &m,
+        &q,
+        &m.initial_velocities(),
+        &m.initial_velocities_given(),
+    )
+    .unwrap();
+    assert_eq!(rule, StartRule::Completed, "{convention}");
+    for (got, want) in v.iter().zip(&want) {
+        assert!(
+            (got - want).abs() < 1e-13,
+            "{convention}: started at {v:?}, converted {want:?}"
+        );
+    }
+    // The same rates set over the file's (a front end's `--set`).
+    let w2 = [-0.2, 0.9, 0.4];
+    let (v2, _) =
+        starting_velocity_with(&m, &q, &[0.0; N], &m.initial_velocities_given(), &w2).unwrap();
+    let l = m.start_rows(&q);
+    for (row, want) in l.as_slice().iter().zip(w2) {
+        let got: f64 = row.iter().zip(&v2).map(|(a, b)| a * b).sum();
+        assert!((got - want).abs() < 1e-13, "{convention}: {got} vs {want}");
+    }
+    assert!(m.constraints(&q).apply(&v2).max_abs() < 1e-13);
+}
+
+#[test]
+fn a_start_given_by_the_body_rates_is_the_converted_one() {
+    start_by_rates::<5>("zxz");
+    start_by_rates::<5>("zyx");
+    start_by_rates::<6>("quaternion");
 }
 
 // --- Curved walls -------------------------------------------------------------

@@ -11,7 +11,7 @@ use dalembert::models::*;
 use dalembert::runtime::prelude::*;
 use dalembert::runtime::simulate::{
     DormandPrince, Integrator, Residual, Rk4, Settings, StartRule, State, Taylor, onto_holonomic,
-    residual, starting_velocity,
+    residual, starting_velocity_with,
 };
 use dalembert::runtime::taylor::MAX_ORDER;
 use dalembert_codegen::Derivation;
@@ -287,7 +287,9 @@ fn set_parameters<M: Surfaces<N>, const N: usize>(
     derived: &[String],
 ) -> Result<(), String> {
     let is_state = |m: &M, name: &str| {
-        m.coordinate_names().contains(&name) || m.velocity_names().contains(&name)
+        m.coordinate_names().contains(&name)
+            || m.velocity_names().contains(&name)
+            || m.start_rate_names().contains(&name)
     };
     for (name, value) in set {
         if is_state(model, name) {
@@ -299,8 +301,14 @@ fn set_parameters<M: Surfaces<N>, const N: usize>(
                 model.name()
             ));
         } else if !model.set_parameter_named(name, *value) {
+            let rates = model.start_rate_names();
+            let rates = if rates.is_empty() {
+                String::new()
+            } else {
+                format!(", or rate given at the start ({})", rates.join(", "))
+            };
             return Err(format!(
-                "`{name}` is not a parameter ({}), coordinate ({}) or velocity ({}) of {}",
+                "`{name}` is not a parameter ({}), coordinate ({}) or velocity ({}){rates} of {}",
                 model.parameter_names().join(", "),
                 model.coordinate_names().join(", "),
                 model.velocity_names().join(", "),
@@ -334,14 +342,21 @@ pub fn starting_state<M: Surfaces<N>, const N: usize>(
     let mut q = model.initial_coordinates();
     let mut v = model.initial_velocities();
     let mut given = model.initial_velocities_given();
+    let rate_names = model.start_rate_names();
+    let mut rates = model.start_values().as_slice().to_vec();
     for (name, value) in set {
         if let Some(i) = model.coordinate_names().iter().position(|c| c == name) {
             q[i] = *value;
         } else if let Some(i) = model.velocity_names().iter().position(|c| c == name) {
             v[i] = *value;
             given[i] = true;
+        } else if let Some(r) =
+            (rate_names.iter().position(|c| c == name)).and_then(|i| rates.get_mut(i))
+        {
+            *r = *value;
         }
     }
+    let rates = &rates[..];
     let mut moved = false;
     let position = residual(model, &q, &v).position;
     if position > 1e-8 && nearest {
@@ -354,10 +369,19 @@ pub fn starting_state<M: Surfaces<N>, const N: usize>(
             "the initial coordinates violate the holonomic constraints (|h(q)| = {position:e}): set them on the constraint manifold"
         ));
     }
-    let (projected, rule) = starting_velocity(model, &q, &v, &given).map_err(|e| {
+    let (projected, rule) = starting_velocity_with(model, &q, &v, &given, rates).map_err(|e| {
         format!("the initial velocity cannot be put on the constraints (A q̇ = 0): {e}")
     })?;
     let names = model.velocity_names();
+    // "the constraints and ball_wz = 5", where rates are given.
+    let stated_rates: Vec<String> = (rate_names.iter().zip(rates))
+        .map(|(n, c)| format!("{n} = {c:e}"))
+        .collect();
+    let and_rates = if stated_rates.is_empty() {
+        String::new()
+    } else {
+        format!(" and {}", stated_rates.join(", "))
+    };
     let note = match rule {
         StartRule::Completed => {
             let followed: Vec<String> = (0..N)
@@ -366,7 +390,7 @@ pub fn starting_state<M: Surfaces<N>, const N: usize>(
                 .collect();
             (!followed.is_empty()).then(|| {
                 format!(
-                    "the velocities the start does not give follow from the constraints: {}",
+                    "the velocities the start does not give follow from the constraints{and_rates}: {}",
                     followed.join(", ")
                 )
             })
@@ -374,7 +398,12 @@ pub fn starting_state<M: Surfaces<N>, const N: usize>(
         StartRule::Projected => {
             let stated: Vec<f64> = (0..N).map(|i| if given[i] { v[i] } else { 0.0 }).collect();
             Some(format!(
-                "the initial velocity {stated:?} is not admissible (A q̇ ≠ 0), and no choice of the velocities it does not give makes it so; using its G-orthogonal projection onto ker A, {projected:?}"
+                "the initial velocity {stated:?} is not admissible (A q̇ ≠ 0){and_rates}, and no choice of the velocities it does not give makes it so; using its G-orthogonal projection onto ker A{}, {projected:?}",
+                if stated_rates.is_empty() {
+                    ""
+                } else {
+                    " and those rates"
+                }
             ))
         }
     };

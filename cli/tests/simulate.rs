@@ -1,15 +1,10 @@
 //! `dalembert simulate` end to end: files written, collisions recorded,
-//! parameters and initial values overridable, clear refusals.
+//! parameters overridable, clear refusals (the starting state is in
+//! `start.rs`).
 
 use std::path::PathBuf;
 mod common;
-use common::dalembert;
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
+use common::{dalembert, scratch};
 
 #[test]
 fn writes_the_trajectory_and_the_plot() {
@@ -104,153 +99,6 @@ fn parameters_and_initial_values_can_be_set() {
         last[3].abs() < 1e-12 && (last[4] - 1.0).abs() < 1e-12,
         "{last:?}"
     );
-}
-
-/// `[initial]` values written with parameters follow `--set`: the §3.2.1
-/// ball starts on the floor (`z = "r"`) whatever its radius. With the
-/// file's value fixed it would start inside the floor of a larger ball.
-#[test]
-fn initial_values_follow_the_parameters_set() {
-    let dir = scratch("simulate-initial");
-    let out = dir.to_str().unwrap();
-    for r in ["1", "0.25"] {
-        let set = format!("r={r}");
-        let (ok, stdout, stderr) = dalembert(&[
-            "simulate",
-            "ball_bounce",
-            "--t-end",
-            "0.6",
-            "--set",
-            &set,
-            "--out",
-            out,
-        ]);
-        assert!(ok, "r = {r}: {stdout}\n{stderr}");
-        let text = std::fs::read_to_string(dir.join("ball_bounce.csv")).unwrap();
-        let first: Vec<f64> = text
-            .lines()
-            .nth(1)
-            .unwrap()
-            .split(',')
-            .take(4)
-            .map(|x| x.parse().unwrap())
-            .collect();
-        assert_eq!(
-            first[3],
-            r.parse::<f64>().unwrap(),
-            "z at the start, r = {r}"
-        );
-        // Back on the floor after 2·ż/g ≈ 0.41 s.
-        assert!(stdout.contains(" 1 collisions"), "r = {r}: {stdout}");
-    }
-    // A coordinate set by name still wins over the file's expression.
-    let (ok, stdout, stderr) = dalembert(&[
-        "simulate",
-        "ball_bounce",
-        "--t-end",
-        "0.1",
-        "--set",
-        "r=1",
-        "--set",
-        "z=2",
-        "--out",
-        out,
-    ]);
-    assert!(ok, "{stdout}\n{stderr}");
-    let text = std::fs::read_to_string(dir.join("ball_bounce.csv")).unwrap();
-    let z: f64 = text
-        .lines()
-        .nth(1)
-        .unwrap()
-        .split(',')
-        .nth(3)
-        .unwrap()
-        .parse()
-        .unwrap();
-    assert_eq!(z, 2.0);
-}
-
-/// `simulate MODEL --set theta=0.5` for 0.1 s into a scratch folder of its
-/// own: (stdout, stderr, the CSV's first row as a lookup by column name).
-fn started_at_tilt(model: &str) -> (String, String, impl Fn(&str) -> f64) {
-    let dir = scratch(&format!("simulate-start-{model}"));
-    let out = dir.to_str().unwrap();
-    let (ok, stdout, stderr) = dalembert(&[
-        "simulate",
-        model,
-        "--set",
-        "theta=0.5",
-        "--t-end",
-        "0.1",
-        "--out",
-        out,
-    ]);
-    assert!(ok, "{stdout}\n{stderr}");
-    let csv = std::fs::read_to_string(dir.join(format!("{model}.csv"))).unwrap();
-    let header: Vec<String> = csv
-        .lines()
-        .next()
-        .unwrap()
-        .split(',')
-        .map(String::from)
-        .collect();
-    let first: Vec<String> = csv
-        .lines()
-        .nth(1)
-        .unwrap()
-        .split(',')
-        .map(String::from)
-        .collect();
-    let value = move |name: &str| {
-        let column = header.iter().position(|h| h == name).unwrap();
-        first[column].parse().unwrap()
-    };
-    (stdout, stderr, value)
-}
-
-/// A velocity `--set` off the constraints is projected onto ker A, and the
-/// first row is that projected state with its own residual: at θ = 0.5 the
-/// rolling ball's file velocity has A q̇ = −0.26, its projection none.
-#[test]
-fn the_first_row_is_the_projected_start() {
-    let (stdout, stderr, value) = started_at_tilt("ball_wall_euler");
-    assert!(stderr.contains("not admissible"), "{stderr}");
-    // x' = r ω_y with ω_y = −ψ' sin θ at φ = 0 (r = 1/2), and y' = −r ω_x = 0.
-    let (x_dot, psi_dot) = (value("x_dot"), value("psi_dot"));
-    assert!(
-        (x_dot + 0.5 * psi_dot * 0.5f64.sin()).abs() < 1e-12,
-        "{x_dot} {psi_dot}"
-    );
-    assert!(value("residual_velocity") < 1e-12);
-    assert!(stdout.contains("|A q̇| = "), "{stdout}");
-    let worst: f64 = stdout
-        .split("|A q̇| = ")
-        .nth(1)
-        .and_then(|s| s.split(',').next())
-        .unwrap()
-        .parse()
-        .unwrap();
-    assert!(worst < 1e-10, "{stdout}");
-}
-
-/// Velocities the start does not give follow from the constraints: the
-/// Chaplygin ball's file gives its three angular rates only, and at the
-/// attitude `--set` chooses the centre's velocity is the rolling one
-/// (ẋ = −r ψ̇ sin θ, ẏ = −r θ̇ at φ = ψ = 0, r = 1/2), the rates unchanged.
-#[test]
-fn velocities_left_out_follow_from_the_constraints() {
-    let (_, stderr, value) = started_at_tilt("chaplygin_ball");
-    assert!(!stderr.contains("not admissible"), "{stderr}");
-    assert!(
-        stderr.contains("follow from the constraints: x_dot = "),
-        "{stderr}"
-    );
-    assert_eq!(
-        (value("phi_dot"), value("theta_dot"), value("psi_dot")),
-        (1.0, 0.5, 2.0)
-    );
-    assert!((value("x_dot") + 0.5 * 2.0 * 0.5f64.sin()).abs() < 1e-12);
-    assert!((value("y_dot") + 0.25).abs() < 1e-12);
 }
 
 #[test]

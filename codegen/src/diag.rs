@@ -97,8 +97,9 @@ pub enum ErrorKind {
     /// T is not a quadratic form in the velocities.
     #[error("the kinetic energy is not a quadratic form in the velocities: {0}")]
     NotQuadratic(String),
-    /// A velocity-level constraint is not linear in the velocities.
-    #[error("this constraint is not linear in the velocities: {0}")]
+    /// A row (a constraint, a contact or normal-velocity row, a rate given
+    /// at the start) is not linear in the velocities.
+    #[error("this row is not linear in the velocities: {0}")]
     NotLinear(String),
     /// A velocity occurs other than polynomially.
     #[error(

@@ -56,6 +56,11 @@ pub enum Quantity {
     /// The starting state of the file's `[initial]`, at the parameters in
     /// use.
     InitialState,
+    /// The rows L(q) of the rates `[initial]` gives that are not velocities
+    /// (definitions linear in them): the start has L(q) q̇ = c.
+    StartRows,
+    /// Their values c, at the parameters in use.
+    StartValues,
 }
 
 /// What an emitted function takes besides the model's parameters.
@@ -343,6 +348,24 @@ pub const TABLE: &[Spec] = &[
         doc: "The starting state of the model file's `[initial]` (zero where it is silent), at these parameters: (q, q̇). The velocities it is silent on follow from the constraints (`VELOCITIES_GIVEN`, `dalembert_runtime::simulate::starting_velocity`).",
         capability: Capability::Dynamics,
         method: None,
+    },
+    Spec {
+        quantity: Quantity::StartRows,
+        name: "start_rows",
+        inputs: Inputs::Coordinates,
+        shape: Shape::Rows,
+        doc: "The rows L(q) of the rates the model file's `[initial]` gives that are not velocities (`START_RATES`, definitions linear in them): the start's velocity has L(q) q̇ = `start_values()`, and the constraints (`dalembert_runtime::simulate::starting_velocity`).",
+        capability: Capability::Dynamics,
+        method: Some(("start_rows", Forward::Plain)),
+    },
+    Spec {
+        quantity: Quantity::StartValues,
+        name: "start_values",
+        inputs: Inputs::Parameters,
+        shape: Shape::Values,
+        doc: "The values the model file's `[initial]` gives the rates of `start_rows`, at these parameters.",
+        capability: Capability::Dynamics,
+        method: Some(("start_values", Forward::Plain)),
     },
     Spec {
         quantity: Quantity::Surface,

@@ -120,6 +120,10 @@ pub enum ProjectorError {
     NonFinite,
     /// The rows are (numerically) dependent: R G⁻¹ Rᵀ is singular.
     DependentRows,
+    /// The conditions on a velocity cannot all hold: rates given at a start
+    /// that no admissible velocity has (they contradict the constraints or
+    /// each other).
+    Inconsistent,
 }
 
 impl core::fmt::Display for ProjectorError {
@@ -131,6 +135,9 @@ impl core::fmt::Display for ProjectorError {
             ProjectorError::NonFinite => "an entry of G(q) or of the rows is not finite",
             ProjectorError::DependentRows => {
                 "the constraint rows are dependent here (B G⁻¹ Bᵀ is singular)"
+            }
+            ProjectorError::Inconsistent => {
+                "the rates given at the start contradict the constraints or each other: no admissible velocity has them all"
             }
         })
     }

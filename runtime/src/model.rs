@@ -190,6 +190,26 @@ pub trait Dynamics<const N: usize>: Model<N, N> {
         [true; N]
     }
 
+    /// The rates the start gives that are not velocities themselves (a
+    /// body's angular velocity, from the model file's `[initial]`), by name:
+    /// each is a row of [`Dynamics::start_rows`] with its value in
+    /// [`Dynamics::start_values`]. None by default.
+    fn start_rate_names(&self) -> &[&str] {
+        &[]
+    }
+    /// The rows L(q) of [`Dynamics::start_rate_names`]' rates (each rate is
+    /// L(q)ᵢ·q̇): the start's velocity meets L(q) q̇ = c besides
+    /// A(q) q̇ = 0 ([`crate::simulate::starting_velocity`]). None by
+    /// default.
+    fn start_rows(&self, q: &[f64; N]) -> Rows<N> {
+        let _ = q;
+        Rows::EMPTY
+    }
+    /// The values c the start gives those rates, at the parameters in use.
+    fn start_values(&self) -> Values<N> {
+        Values::EMPTY
+    }
+
     /// Potential energy V(q).
     fn potential(&self, q: &[f64; N]) -> f64;
     /// The holonomic constraints' values h(q) (zero on the constraint

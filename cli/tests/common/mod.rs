@@ -1,5 +1,6 @@
 //! Helpers shared by the CLI's integration tests.
 
+use std::path::PathBuf;
 use std::process::Command;
 
 /// Runs the CLI with `args`: whether it succeeded, its standard output and
@@ -22,4 +23,12 @@ pub fn dalembert_exit(args: &[&str]) -> (Option<i32>, String, String) {
         String::from_utf8_lossy(&out.stdout).into_owned(),
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
+}
+
+/// An empty scratch folder `name` under the tests' temporary directory.
+#[allow(dead_code)] // not every test binary writes files
+pub fn scratch(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
 }

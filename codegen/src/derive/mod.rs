@@ -156,6 +156,7 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
         motion_systems.extend(m);
     }
     functions.push(initial_state(&sym, &compile, cx)?);
+    functions.extend(start_rates(&sym, &compile, cx)?);
     let mut functions = functions.into_iter().flatten().collect();
     let mut walls = walls;
     let dims = (
@@ -303,6 +304,33 @@ fn initial_state(
         .next()
         .map_or(&sym.model.kinetic_energy.span, |e| &e.span);
     compile.applicable(cx, Quantity::InitialState, &outputs, 0, span)
+}
+
+/// The conditions `[initial]` puts on rates that are not velocities: each
+/// named definition's row L(q) (it must be linear in the velocities, as a
+/// constraint) and its value as a function of the parameters. Nothing for
+/// a file without them.
+fn start_rates(
+    sym: &symbols::Symbols,
+    compile: &Compiler,
+    cx: &mut Collector,
+) -> Result<Vec<Option<Function>>, Reported> {
+    let rates = &sym.model.start_rates;
+    let Some(first) = rates.first() else {
+        return Ok(Vec::new());
+    };
+    let (mut rows, mut values) = (Vec::new(), Vec::new());
+    for r in rates {
+        let e = sym.parse(&r.rate, cx)?;
+        let what = format!("[initial] `{}`", r.name);
+        rows.extend(checks::linear_row(sym, cx, &e, &r.rate.span, &what)?);
+        values.push(sym.parse(&r.value, cx)?);
+    }
+    let k = rates.len();
+    Ok(vec![
+        compile.applicable(cx, Quantity::StartRows, &rows, k, &first.rate.span)?,
+        compile.applicable(cx, Quantity::StartValues, &values, k, &first.value.span)?,
+    ])
 }
 
 /// Turns expressions into the emitted functions of one model.

@@ -38,6 +38,15 @@ pub(super) fn inherent_impl(d: &Ctx) -> TokenStream {
         .walls
         .iter()
         .map(|w| format_ident!("{}", camel(&w.name)));
+    // Only where `[initial]` gives rates that are not velocities.
+    let rates: Vec<&String> = d.model.start_rates.iter().map(|r| &r.name).collect();
+    let start_rates = (!rates.is_empty()).then(|| {
+        quote! {
+            /// The rates the model file's `[initial]` gives that are not velocities
+            /// (definitions linear in them): `start_rows` and `start_values`, in order.
+            pub const START_RATES: &'static [&'static str] = &[#(#rates),*];
+        }
+    });
     let precompute = precompute(d);
     let series = super::taylor::functions(d);
     quote! {
@@ -68,6 +77,7 @@ pub(super) fn inherent_impl(d: &Ctx) -> TokenStream {
             /// Which initial velocities the model file gives; the others follow from the
             /// constraints at the start (`dalembert_runtime::simulate::starting_velocity`).
             pub const VELOCITIES_GIVEN: [bool; #nn] = [#(#given),*];
+            #start_rates
             /// The model with the given parameters.
             pub fn new(params: Params) -> Self {
                 Self { params, pre: Self::precompute(&params) }

@@ -145,12 +145,15 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
     };
     let (surface_bounds, normal_bounds) = (bound("surface"), bound("normal"));
     let interval = quote! { ::dalembert_runtime::interval::Interval };
+    let start_rate_names = (!d.model.start_rates.is_empty())
+        .then(|| quote! { fn start_rate_names(&self) -> &[&str] { Self::START_RATES } });
     quote! {
         #model_impl
         impl ::dalembert_runtime::Dynamics<#nl> for #ty {
             fn initial_coordinates(&self) -> [f64; #ql] { self.initial_state().0 }
             fn initial_velocities(&self) -> [f64; #nl] { self.initial_state().1 }
             fn initial_velocities_given(&self) -> [bool; #nl] { Self::VELOCITIES_GIVEN }
+            #start_rate_names
             #( #dynamics )*
         }
         #no_walls

@@ -69,6 +69,11 @@ pub struct Interpreted<const N: usize> {
     initial_state: Compiled,
     /// Which initial velocities the file gives.
     given: [bool; N],
+    /// The rates `[initial]` gives that are not velocities, their rows and
+    /// values (none: `None`).
+    start_rate_names: &'static [&'static str],
+    start_rows: Option<Compiled>,
+    start_values: Option<Compiled>,
     mass_matrix: Compiled,
     kinetic_energy: Compiled,
     potential: Compiled,
@@ -220,6 +225,9 @@ impl<const N: usize> Interpreted<N> {
             parameters: leak_names(m.params.iter().map(|p| p.name.clone())),
             initial_state: model_fn(Quantity::InitialState)?,
             given: core::array::from_fn(|i| m.velocities_given().get(i).copied().unwrap_or(true)),
+            start_rate_names: leak_names(m.start_rates.iter().map(|r| r.name.clone())),
+            start_rows: find(&d.functions, Quantity::StartRows),
+            start_values: find(&d.functions, Quantity::StartValues),
             mass_matrix: model_fn(Quantity::MassMatrix)?,
             kinetic_energy: model_fn(Quantity::KineticEnergy)?,
             potential: model_fn(Quantity::Potential)?,
@@ -251,6 +259,8 @@ impl<const N: usize> Interpreted<N> {
         ]
         .into_iter()
         .chain(self.holonomic.as_mut())
+        .chain(self.start_rows.as_mut())
+        .chain(self.start_values.as_mut())
         .chain(self.accelerations.as_mut())
         .chain(self.accelerations_tangent.as_mut())
         .chain(self.accelerations_parameter_tangent.as_mut());
@@ -445,6 +455,21 @@ impl<const N: usize> Dynamics<N> for Interpreted<N> {
     }
     fn initial_velocities_given(&self) -> [bool; N] {
         self.given
+    }
+    fn start_rate_names(&self) -> &[&str] {
+        self.start_rate_names
+    }
+    fn start_rows(&self, q: &[f64; N]) -> Rows<N> {
+        match &self.start_rows {
+            Some(c) => self.rows(c, q),
+            None => Rows::EMPTY,
+        }
+    }
+    fn start_values(&self) -> Values<N> {
+        match &self.start_values {
+            Some(c) => Values::new(self.vector(c, &[0.0; N], &[]), c.rows),
+            None => Values::EMPTY,
+        }
     }
     fn potential(&self, q: &[f64; N]) -> f64 {
         self.scalar(&self.potential, q, &[])

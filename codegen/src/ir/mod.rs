@@ -9,6 +9,7 @@ mod bodies;
 pub mod expr;
 pub use bodies::FromBodies;
 mod file;
+mod initial;
 mod limits;
 mod names;
 mod number;
@@ -195,6 +196,20 @@ pub struct Wall {
     pub span: Range<usize>,
 }
 
+/// A condition of `[initial]` on a rate that is not a velocity: the
+/// definition `rate`, linear in the velocities (L(q) q̇), equals `value` at
+/// the start.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StartRate {
+    /// The definition's name.
+    pub name: String,
+    /// The definition's name as an expression, placed at its `[initial]`
+    /// key (errors in its row are reported there).
+    pub rate: Expr,
+    /// Its value, an expression of the parameters.
+    pub value: Expr,
+}
+
 /// A validated model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Model {
@@ -234,6 +249,9 @@ pub struct Model {
     /// The same state as expressions of the parameters, slot by slot
     /// (`None`: zero), so that it follows parameters set later.
     pub initial_state: Vec<Option<Expr>>,
+    /// Conditions `[initial]` puts on rates that are not velocities (a
+    /// definition linear in them, given a value), in file order.
+    pub start_rates: Vec<StartRate>,
     /// What the bodies layer derived (T, V, rows, surfaces, definitions),
     /// in the file's order; empty for a file without `[[body]]`.
     pub from_bodies: Vec<FromBodies>,
@@ -509,12 +527,9 @@ fn check_velocity_degrees(model: &Model, cx: &mut Collector) {
             Some(model.kinetic_energy.span.clone()),
         );
     }
-    let rows = model.constraints.iter().chain(
-        model
-            .walls
-            .iter()
-            .flat_map(|w| w.normal_velocity.iter().chain(w.contact.iter())),
-    );
+    let rows = (model.constraints.iter())
+        .chain((model.walls.iter()).flat_map(|w| w.normal_velocity.iter().chain(w.contact.iter())))
+        .chain(model.start_rates.iter().map(|r| &r.rate));
     for e in rows {
         let d = of(e);
         if d > 1 {

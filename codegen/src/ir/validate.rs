@@ -104,7 +104,12 @@ impl Validator<'_> {
         limits::constraint_count(self.cx, &dynamics, velocities.len());
 
         let walls = self.walls(kind, &file.wall);
-        let initial = self.initial(&coordinates, &velocities, &file.initial);
+        let defined: Vec<String> = file
+            .definitions
+            .keys()
+            .map(|k| k.get_ref().clone())
+            .collect();
+        let initial = self.initial(&coordinates, &velocities, &defined, &file.initial);
         // A model with coordinates may have no wall (motion only); one
         // without describes a collision instant and needs one.
         if file.wall.is_empty() && kind == Kind::Instantaneous {
@@ -116,7 +121,7 @@ impl Validator<'_> {
             );
         }
         let state_len = coordinates.len() + velocities.len();
-        let (initial, initial_state) =
+        let initial =
             self.initial_values(&params, &derived_names, &definitions, initial, state_len);
         Some(Model {
             name,
@@ -133,8 +138,9 @@ impl Validator<'_> {
             constraints,
             walls,
             projector,
-            initial,
-            initial_state,
+            initial: initial.values,
+            initial_state: initial.exprs,
+            start_rates: initial.rates,
             from_bodies: Vec::new(),
             source: self.text.to_string(),
             file: path.to_path_buf(),
@@ -522,107 +528,6 @@ impl Validator<'_> {
             });
         }
         out
-    }
-
-    /// The `[initial]` table: for each coordinate and velocity it names,
-    /// an expression of the parameters (`pi/2`, `r + 1`).
-    fn initial(
-        &mut self,
-        coordinates: &[String],
-        velocities: &[String],
-        decls: &IndexMap<Spanned<String>, Spanned<Number>>,
-    ) -> Vec<(usize, String, Expr)> {
-        let mut out = Vec::new();
-        for (name, value) in decls {
-            let n = name.get_ref();
-            let Some(slot) = coordinates.iter().chain(velocities).position(|c| c == n) else {
-                self.cx.error(
-                    ErrorKind::Structure(format!(
-                        "[initial] `{n}` is not a coordinate or a velocity of the model"
-                    )),
-                    Some(name.span()),
-                );
-                continue;
-            };
-            let text = match value.get_ref() {
-                Number::Int(i) => i.to_string(),
-                Number::Float(f) if f.is_finite() => format!("{f:e}"),
-                Number::Float(f) => {
-                    self.cx.error(
-                        ErrorKind::Structure(format!("[initial] `{n}`: {f} is not finite")),
-                        Some(value.span()),
-                    );
-                    continue;
-                }
-                Number::Text(t) => t.clone(),
-            };
-            let e = self.expr(&Spanned::new(value.span(), text));
-            out.push((slot, n.clone(), e));
-        }
-        out
-    }
-
-    /// The initial values at the file's parameter values, and the
-    /// expressions slot by slot; names other than parameters are reported.
-    fn initial_values(
-        &mut self,
-        params: &[Param],
-        derived: &[String],
-        definitions: &[(String, Expr)],
-        initial: Vec<(usize, String, Expr)>,
-        n: usize,
-    ) -> (Vec<f64>, Vec<Option<Expr>>) {
-        let mut env: HashMap<String, f64> =
-            params.iter().map(|p| (p.name.clone(), p.value)).collect();
-        for (name, e) in definitions.iter().filter(|(d, _)| derived.contains(d)) {
-            if let Some(v) = e.node.value(&|k| env.get(k).copied()) {
-                env.insert(name.clone(), v);
-            }
-        }
-        let mut out = vec![0.0; n];
-        let mut exprs = vec![None; n];
-        for (slot, name, e) in initial {
-            let mut foreign = None;
-            e.node.visit_names(&mut |k, r| {
-                if !params.iter().any(|p| p.name == k)
-                    && !derived.iter().any(|d| d == k)
-                    && foreign.is_none()
-                {
-                    foreign = Some((k.to_string(), r.clone()));
-                }
-            });
-            if let Some((k, r)) = foreign {
-                self.cx.error(
-                    ErrorKind::Structure(format!(
-                        "[initial] `{name}`: `{k}` is not a parameter; initial values may use parameters, pi and e"
-                    )),
-                    Some(e.at(&r)),
-                );
-                continue;
-            }
-            if let Some((r, what)) = e.node.constant_problem() {
-                let text = e.text.get(r.clone()).unwrap_or_default().to_string();
-                self.cx
-                    .error(ErrorKind::UndefinedConstant { text, what }, Some(e.at(&r)));
-                continue;
-            }
-            match e.node.value(&|k| env.get(k).copied()) {
-                Some(v) if v.is_finite() && slot < n => {
-                    out[slot] = v;
-                    exprs[slot] = Some(e);
-                }
-                _ => {
-                    self.cx.error(
-                        ErrorKind::Structure(format!(
-                            "[initial] `{name}`: `{}` has no finite real value at the file's parameters",
-                            e.text
-                        )),
-                        Some(e.span.clone()),
-                    );
-                }
-            }
-        }
-        (out, exprs)
     }
 
     /// A derived parameter may use only parameters (and other derived

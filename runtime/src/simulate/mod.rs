@@ -76,7 +76,8 @@ mod variational;
 
 pub use integrator::{DormandPrince, Integrator, Rk4, Taylor};
 pub use projection::{
-    StartRule, admissible, onto_holonomic, residual, starting_velocity, tangent_direction,
+    StartRule, admissible, onto_holonomic, residual, starting_velocity, starting_velocity_with,
+    tangent_direction,
 };
 pub use return_map::{Return, ReturnError, Section, return_map};
 pub use room::SeriesRoom;

@@ -150,34 +150,64 @@ pub fn tangent_direction<M: Dynamics<N>, const N: usize>(
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StartRule {
     /// The given entries are kept and the others follow from the
-    /// constraints.
+    /// constraints (and the rates given).
     Completed,
     /// The given entries cannot be completed to an admissible velocity: the
-    /// given velocity (zero elsewhere) projected onto ker A, as [`admissible`].
+    /// given velocity (zero elsewhere) projected G-orthogonally onto ker A,
+    /// as [`admissible`], and onto the rates given where there are.
     Projected,
 }
 
 /// The starting velocity at q from the entries of `v` marked in `given`
-/// (the others of `v` are ignored), as a user states a start: the given
-/// entries are kept and the others follow from A(q) q̇ = 0. Where the
-/// constraints leave a choice, the others have the least kinetic energy of
-/// their own, ½ uᵀ G_uu u over the entries u not given: nothing is added to
-/// what the constraints force (a ball started by its centre's velocity
-/// rolls without spin), and they are all zero when the given entries are
-/// admissible by themselves. When no choice of the others makes
+/// (the others of `v` are ignored) and the model's start rates
+/// ([`Dynamics::start_rows`] with [`Dynamics::start_values`]), as a user
+/// states a start: the given entries and rates are kept and the other
+/// entries follow from A(q) q̇ = 0. Where the constraints leave a choice,
+/// the others have the least kinetic energy of their own, ½ uᵀ G_uu u over
+/// the entries u not given: nothing is added to what the constraints and
+/// rates force (a ball started by its centre's velocity rolls without
+/// spin), and they are all zero when the given entries are admissible by
+/// themselves and no rate is given. When no choice of the others makes
 /// the velocity admissible, the given velocity with zeros elsewhere is
-/// projected G-orthogonally onto ker A ([`StartRule::Projected`]).
+/// projected G-orthogonally onto ker A and the rates
+/// ([`StartRule::Projected`]). Rates that no admissible velocity has are
+/// [`ProjectorError::Inconsistent`].
 pub fn starting_velocity<M: Dynamics<N>, const N: usize>(
     m: &M,
     q: &[f64; N],
     v: &[f64; N],
     given: &[bool; N],
 ) -> Result<([f64; N], StartRule), ProjectorError> {
+    starting_velocity_with(m, q, v, given, m.start_values().as_slice())
+}
+
+/// [`starting_velocity`] with `rates` in place of the model's
+/// [`Dynamics::start_values`], one per [`Dynamics::start_rate_names`] (a
+/// front end's `--set ball_wz=5`); rows past the values given are not
+/// imposed.
+pub fn starting_velocity_with<M: Dynamics<N>, const N: usize>(
+    m: &M,
+    q: &[f64; N],
+    v: &[f64; N],
+    given: &[bool; N],
+    rates: &[f64],
+) -> Result<([f64; N], StartRule), ProjectorError> {
     let v: [f64; N] = core::array::from_fn(|i| if given[i] { v[i] } else { 0.0 });
     let a = m.constraints(q);
-    if a.is_empty() {
+    let l = m.start_rows(q);
+    // (row, value) of each rate given.
+    let rate_rows = || l.as_slice().iter().copied().zip(rates.iter().copied());
+    if a.is_empty() && rate_rows().next().is_none() {
         return Ok((v, StartRule::Completed));
     }
+    let scale = 1.0 + norm(q) + norm(&v) + rate_rows().map(|(_, c)| c.abs()).fold(0.0, f64::max);
+    // Off the constraints and off the rates given, at most.
+    let off = |x: &[f64; N]| {
+        let rate_off = rate_rows()
+            .map(|(row, c)| (linalg::dot(&row, x) - c).abs())
+            .fold(0.0, f64::max);
+        a.apply(x).max_abs().max(rate_off)
+    };
     // The metric: G on the entries not given, the identity on the given
     // ones (fixed by their rows, so it only has to be positive there).
     let g = m.mass_matrix(q);
@@ -191,18 +221,27 @@ pub fn starting_velocity<M: Dynamics<N>, const N: usize>(
     let unit = |i: usize| core::array::from_fn(|j| if i == j { 1.0 } else { 0.0 });
     let conditions = a.as_slice().iter().map(|row| (*row, 0.0));
     let fixed = (0..N).filter(|i| given[*i]).map(|i| (unit(i), v[i]));
-    let completed = linalg::least_solution(&h, conditions.chain(fixed))?;
-    let scale = 1.0 + norm(q) + norm(&v);
-    let off = a.apply(&completed).max_abs();
+    let completed = linalg::least_solution(&h, conditions.chain(fixed).chain(rate_rows()))?;
     let moved = (0..N)
         .filter(|i| given[*i])
         .map(|i| (completed[i] - v[i]).abs())
         .fold(0.0, f64::max);
-    if off <= ADMISSIBLE * scale && moved <= ADMISSIBLE * scale {
+    if off(&completed) <= ADMISSIBLE * scale && moved <= ADMISSIBLE * scale {
         // The given entries exactly as given (the solve rounds them).
         let kept = core::array::from_fn(|i| if given[i] { v[i] } else { completed[i] });
-        Ok((kept, StartRule::Completed))
+        return Ok((kept, StartRule::Completed));
+    }
+    if rate_rows().next().is_none() {
+        return Ok((admissible(m, q, &v)?, StartRule::Projected));
+    }
+    // v plus its G-smallest change d with A(v + d) = 0 and L(v + d) = c.
+    let conditions = (a.as_slice().iter()).map(|row| (*row, -linalg::dot(row, &v)));
+    let to_rates = rate_rows().map(|(row, c)| (row, c - linalg::dot(&row, &v)));
+    let d = linalg::least_solution(&g, conditions.chain(to_rates))?;
+    let projected = core::array::from_fn(|i| v[i] + d[i]);
+    if off(&projected) <= ADMISSIBLE * scale {
+        Ok((projected, StartRule::Projected))
     } else {
-        Ok((admissible(m, q, &v)?, StartRule::Projected))
+        Err(ProjectorError::Inconsistent)
     }
 }
