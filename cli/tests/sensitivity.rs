@@ -108,7 +108,12 @@ fn dropped_run(dir: &str, method: &str, flags: &[&str]) -> (String, String, Vec<
 /// y(t) = v τ − g τ²/2, τ = t − (2m − 1) v/g after m bounces, v = √(2 g y₀).
 /// So ∂y/∂y₀ = (τ − (2m − 1)(v − g τ)/g)·g/v and ∂ẏ/∂y₀ = 2m·g/v: at the
 /// n-th bounce ∂y/∂y₀ is 2n − 1 just before and −(2n − 1) just after.
-/// `--phi` writes both entries on every row (each a step's end), and each
+/// The n-th bounce comes at t*ₙ = (2n − 1) v/g, so ∂t*ₙ/∂y₀ = (2n − 1)/v;
+/// started with a small speed ẏ₀ the first comes at (ẏ₀ + √(ẏ₀² + 2gy₀))/g
+/// and the bounce speed √(ẏ₀² + 2gy₀) does not move at ẏ₀ = 0, so
+/// ∂t*ₙ/∂ẏ₀ = 1/g for every n.
+/// `--phi` writes the entries on every row (each a step's end) and the
+/// instants' derivatives on the row before each bounce, and each
 /// method's columns agree with the closed form.
 #[test]
 fn phi_columns_of_a_bouncing_point_follow_its_closed_form() {
@@ -116,10 +121,10 @@ fn phi_columns_of_a_bouncing_point_follow_its_closed_form() {
     let (g, y0) = (9.81f64, 1.0f64);
     let v = (2.0 * g * y0).sqrt();
     for method in ["dormand-prince", "taylor", "rk4"] {
-        let (_, header, lines) = dropped_run(&dir, method, &["--phi", "y/y, y_dot/y"]);
+        let (_, header, lines) = dropped_run(&dir, method, &["--phi", "y/y, y_dot/y, y/y_dot"]);
         assert_eq!(
             header,
-            "t,y,y_dot,energy,residual_velocity,residual_position,collision,dy/dy(0),dy_dot/dy(0)"
+            "t,y,y_dot,energy,residual_velocity,residual_position,collision,dy/dy(0),dy_dot/dy(0),dy/dy_dot(0),dt_collision/dy(0),dt_collision/dy_dot(0)"
         );
         let (mut bounces, mut rows) = (0, 0);
         for cells in &lines {
@@ -128,6 +133,22 @@ fn phi_columns_of_a_bouncing_point_follow_its_closed_form() {
             // A bounce's first row is before it, the next after it.
             let before = cells[6] == "floor";
             let m = f64::from(bounces);
+            if before {
+                let (by_y, by_v) = (at(10), at(11));
+                let (want_y, want_v) = ((2.0 * m + 1.0) / v, 1.0 / g);
+                assert!(
+                    (by_y - want_y).abs() <= 1e-7 * want_y
+                        && (by_v - want_v).abs() <= 1e-7 * want_v,
+                    "{method}, bounce {}: ∂t*/∂(y₀, ẏ₀) = ({by_y}, {by_v}) against ({want_y}, {want_v})",
+                    bounces + 1
+                );
+            } else {
+                assert_eq!(
+                    (cells[10].as_str(), cells[11].as_str()),
+                    ("", ""),
+                    "{method}, t = {t}"
+                );
+            }
             let (want_dy, want_dv) = if before {
                 (2.0 * m + 1.0, 2.0 * m * g / v)
             } else {
@@ -177,7 +198,10 @@ fn phi_entries_are_named_as_the_model_names_its_state() {
     let csv = std::fs::read_to_string(PathBuf::from(&dir).join("pendulum_wall.csv")).unwrap();
     let header = csv.lines().next().unwrap();
     assert!(
-        header.ends_with(",dy_dot/dx(0),dy_dot/dy(0),dy_dot/dx_dot(0),dy_dot/dy_dot(0)"),
+        header.ends_with(
+            ",dy_dot/dx(0),dy_dot/dy(0),dy_dot/dx_dot(0),dy_dot/dy_dot(0),\
+             dt_collision/dx(0),dt_collision/dy(0),dt_collision/dx_dot(0),dt_collision/dy_dot(0)"
+        ),
         "{header}"
     );
     // Φ(0) = I.
@@ -187,6 +211,7 @@ fn phi_entries_are_named_as_the_model_names_its_state() {
         .unwrap()
         .split(',')
         .skip(9)
+        .take(16)
         .map(|c| c.parse().unwrap())
         .collect();
     let identity: Vec<f64> = (0..16)

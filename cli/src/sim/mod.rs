@@ -51,7 +51,10 @@ pub struct SimulateArgs {
     /// and B coordinate or velocity names, e.g. `x/x,x/x_dot`), or `all`.
     /// Follows Φ as `--sensitivity` does. Every row is then a step's end
     /// (Taylor's method too stops a step at each row); the row just before
-    /// a collision has Φ just before it, the row after it Φ after it.
+    /// a collision has Φ just before it, the row after it Φ after it. For
+    /// each B named, a column `dt_collision/dB(0)` has how the collision
+    /// instant moves with B at the start (∂t*/∂B₀) on the row before each
+    /// collision, empty on the others.
     #[arg(long)]
     pub phi: Option<String>,
     /// Parameters to differentiate the run by, separated by commas (e.g.

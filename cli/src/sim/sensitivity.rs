@@ -83,12 +83,12 @@ impl<'p, const N: usize> Followed<'p, N> {
     pub(super) fn values(&self, before: bool) -> Vec<Option<f64>> {
         let mut out = Vec::with_capacity(self.names.len());
         if let (Some(columns), Some(phi)) = (&self.columns, &self.phi) {
-            let m = if before {
-                phi.before_collision()
+            let (m, gradient) = if before {
+                (phi.before_collision(), phi.collision_gradient())
             } else {
-                phi.matrix()
+                (phi.matrix(), None)
             };
-            out.extend(columns.values(m).into_iter().map(Some));
+            out.extend(columns.values(m, gradient));
         }
         for (_, s) in &self.by {
             let (dq, dv) = if before {
@@ -273,7 +273,10 @@ fn report<M: Surfaces<N>, const N: usize>(
 pub(super) struct Columns {
     /// (row, column) of Φ over x = (q, q̇).
     entries: Vec<(usize, usize)>,
-    /// Their CSV headers, `dA/dB(0)`.
+    /// The start's components the entries are by (each once, in their
+    /// order): the collision instant's derivative by each is a column too.
+    starts: Vec<usize>,
+    /// Their CSV headers, `dA/dB(0)`, then `dt_collision/dB(0)`.
     pub(super) names: Vec<String>,
 }
 
@@ -313,26 +316,49 @@ impl Columns {
                 })
                 .collect::<Result<Vec<_>, String>>()?
         };
-        let names = entries
-            .iter()
+        let mut starts: Vec<usize> = Vec::new();
+        for &(_, j) in &entries {
+            if !starts.contains(&j) {
+                starts.push(j);
+            }
+        }
+        let names = (entries.iter())
             .map(|&(i, j)| format!("d{}/d{}(0)", names[i], names[j]))
+            .chain(
+                starts
+                    .iter()
+                    .map(|&j| format!("dt_collision/d{}(0)", names[j])),
+            )
             .collect();
-        Ok(Self { entries, names })
+        Ok(Self {
+            entries,
+            starts,
+            names,
+        })
     }
 
-    /// The entries' values in `phi`.
-    pub(super) fn values<const N: usize>(&self, phi: &StateMatrix<N>) -> Vec<f64> {
-        self.entries
+    /// The entries' values in `phi` (Φ, or Φ⁻ on the row before a
+    /// collision), then the collision instant's derivative by each start
+    /// component, `gradient` (∂t*/∂q₀, ∂t*/∂q̇₀): on the row before a
+    /// collision only, empty (`None`) on the others.
+    pub(super) fn values<const N: usize>(
+        &self,
+        phi: &StateMatrix<N>,
+        gradient: Option<([f64; N], [f64; N])>,
+    ) -> Vec<Option<f64>> {
+        let entries = self.entries.iter().map(|&(i, j)| {
+            let block = match (i < N, j < N) {
+                (true, true) => &phi.qq,
+                (true, false) => &phi.qv,
+                (false, true) => &phi.vq,
+                (false, false) => &phi.vv,
+            };
+            Some(block[i % N][j % N])
+        });
+        let instants = self
+            .starts
             .iter()
-            .map(|&(i, j)| {
-                let block = match (i < N, j < N) {
-                    (true, true) => &phi.qq,
-                    (true, false) => &phi.qv,
-                    (false, true) => &phi.vq,
-                    (false, false) => &phi.vv,
-                };
-                block[i % N][j % N]
-            })
-            .collect()
+            .map(|&j| gradient.map(|(by_q, by_v)| if j < N { by_q[j] } else { by_v[j - N] }));
+        entries.chain(instants).collect()
     }
 }
