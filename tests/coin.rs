@@ -6,7 +6,10 @@
 //!   A v = 0 through tilted impacts;
 //! - into a rough wall: the rim point's velocity reversed, the floor's
 //!   contact at rest and the energy kept through each impact, with
-//!   Dormand–Prince and Taylor's method.
+//!   Dormand–Prince and Taylor's method;
+//! - inside a smooth spherical dome: the wall's f against a search over
+//!   the rim, and each impact against the smooth law from G, the rows and
+//!   that search's gradient.
 //!
 //! Uses the symbolic engine: run one test at a time (`RUST_TEST_THREADS=1`).
 
@@ -327,4 +330,133 @@ fn a_coin_bounces_off_a_rough_wall() {
         let reversed = (0..5).all(|i| (after[i] + before[i]).abs() < 1e-6);
         assert!(!reversed, "merely reversed: {before:?} -> {after:?}");
     }
+}
+
+/// The farthest distance² of the coin's rim from `c` at q = (x, y, φ, θ, ψ)
+/// (centre (x, y, R sin θ), attitude R_z(φ) R_x(θ) R_z(ψ), rim in the
+/// body's x-y plane), by search over the rim: samples, then a ternary
+/// search about the best one.
+fn rim_farthest(q: &[f64; 5], r: f64, c: [f64; 3]) -> f64 {
+    let (phi, theta, psi) = (q[2], q[3], q[4]);
+    let rz = |a: f64| {
+        [
+            [a.cos(), -a.sin(), 0.0],
+            [a.sin(), a.cos(), 0.0],
+            [0.0, 0.0, 1.0],
+        ]
+    };
+    let rx = |a: f64| {
+        [
+            [1.0, 0.0, 0.0],
+            [0.0, a.cos(), -a.sin()],
+            [0.0, a.sin(), a.cos()],
+        ]
+    };
+    let mul = |a: [[f64; 3]; 3], b: [[f64; 3]; 3]| {
+        std::array::from_fn::<[f64; 3], 3, _>(|i| {
+            std::array::from_fn(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum())
+        })
+    };
+    let rot = mul(mul(rz(phi), rx(theta)), rz(psi));
+    let centre = [q[0], q[1], r * theta.sin()];
+    let at = |t: f64| -> f64 {
+        (0..3)
+            .map(|i| {
+                let p = centre[i] + r * (t.cos() * rot[i][0] + t.sin() * rot[i][1]) - c[i];
+                p * p
+            })
+            .sum()
+    };
+    let samples = 720;
+    let step = std::f64::consts::TAU / samples as f64;
+    let best = (0..samples)
+        .map(|k| k as f64 * step)
+        .max_by(|a, b| at(*a).total_cmp(&at(*b)))
+        .unwrap();
+    let (mut lo, mut hi) = (best - step, best + step);
+    for _ in 0..200 {
+        let (m1, m2) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
+        if at(m1) < at(m2) {
+            lo = m1;
+        } else {
+            hi = m2;
+        }
+    }
+    at(0.5 * (lo + hi))
+}
+
+/// The coin rolling inside a smooth spherical dome (tests/bodies/
+/// coin_in_sphere.toml: radius ρ = 2 about (0, 0, 1); the wall's f derived
+/// from the disk, its rim's point farthest from the dome's centre, in
+/// closed form). Against a search over the rim written here: f = (ρ² −
+/// max |P − c|²)/(2ρ) at random configurations (1e-12), and through each
+/// impact of a tilted, turning run: the impact is on that surface, and v⁺
+/// is the smooth law (I − 2P)v⁻ with P from G, the rolling rows and the
+/// normal by central differences of the search (the runtime's generic
+/// `linalg::projector`, not the generated map), the energy kept.
+#[test]
+fn a_coin_meets_a_smooth_sphere_where_its_rim_is_farthest() {
+    let d = derived("tests/bodies", "coin_in_sphere");
+    let m = Interpreted::<5>::new(&d).unwrap();
+    let (r, rho, c) = (0.5, 2.0, [0.0, 0.0, 1.0]);
+    let dome = m.walls()[0];
+    let f = |q: &[f64; 5]| (rho * rho - rim_farthest(q, r, c)) / (2.0 * rho);
+    let mut seed = 7u64;
+    for _ in 0..200 {
+        let mut u = || common::lcg(&mut seed);
+        let q = [
+            2.0 * u() - 1.0,
+            2.0 * u() - 1.0,
+            6.0 * u(),
+            0.3 + 2.5 * u(),
+            6.0 * u(),
+        ];
+        let (got, want) = (m.surface(dome, &q), f(&q));
+        assert!(
+            (got - want).abs() < 1e-12,
+            "at {q:?}: f = {got}, the rim says {want}"
+        );
+    }
+    let x0 = coin_start(&m, [0.2, 0.1, 0.3, 1.2, 0.0], [0.6, 0.0, 9.0]);
+    let e0 = m.energy(&x0.q, &x0.v);
+    let mut sim = Simulator::new(&m, x0, common::dormand_prince(1e-12)).unwrap();
+    let mut impacts = 0;
+    sim.run(8.0, |step| {
+        if let Some(col) = &step.collision {
+            impacts += 1;
+            let q = col.q;
+            assert!(
+                f(&q).abs() < 1e-9,
+                "impact off the rim's surface: f = {}",
+                f(&q)
+            );
+            let h = 1e-6;
+            let normal: [f64; 5] = std::array::from_fn(|j| {
+                let (mut a, mut b) = (q, q);
+                a[j] += h;
+                b[j] -= h;
+                (f(&a) - f(&b)) / (2.0 * h)
+            });
+            let mut rows = vec![normal];
+            rows.extend_from_slice(m.constraints(&q).as_slice());
+            let p = dalembert::runtime::linalg::projector(&m.mass_matrix(&q), &rows).unwrap();
+            let v = col.v_minus;
+            let want: Vec<f64> = (0..5)
+                .map(|i| v[i] - 2.0 * (0..5).map(|j| p[i][j] * v[j]).sum::<f64>())
+                .collect();
+            let scale = v.iter().fold(1.0f64, |s, x| s.max(x.abs()));
+            for i in 0..5 {
+                assert!(
+                    (col.v_plus[i] - want[i]).abs() < 1e-6 * scale,
+                    "v⁺ {:?}, the law says {want:?}",
+                    col.v_plus
+                );
+            }
+            let e = m.energy(&q, &col.v_plus);
+            assert!((e - e0).abs() < 1e-9 * e0, "energy {e0} -> {e}");
+        }
+        true
+    })
+    .unwrap();
+    assert!(impacts >= 3, "{impacts} impacts with the dome");
 }

@@ -10,7 +10,7 @@ use toml::Spanned;
 use super::super::Function;
 use super::super::file::{KnifeEdgeDecl, PlaneDecl, RollingDecl, RoundDecl, WallDecl};
 use super::frames::{self, Vec3, cross, dot, minus, plus, scale};
-use super::sym::{Sym, call, div, int, mul, square, sub};
+use super::sym::{Sym, add, call, div, int, mul, square, sub};
 use super::{Body, Layer, structure};
 
 /// A surface by shape: a plane (unit normal, offset, the normal's largest
@@ -442,6 +442,13 @@ impl Layer<'_> {
         let Some(body) = self.find(&body_name) else {
             return;
         };
+        if rough && body.disk.is_some() && matches!(shape, Shape::Round(_, None, _)) {
+            self.cx.error(
+                structure("a disk meets a sphere wall with the `smooth` law only: the rough law's contact rows at the rim make the derivation's exact rank test of B too large"),
+                w.law.as_ref().map(|l| l.span()),
+            );
+            return;
+        }
         let r = body.radius.clone().unwrap_or(int(0));
         // The surface; the factor the contact point's velocity is scaled
         // by in the rough rows, and the point's offset from the centre
@@ -467,9 +474,34 @@ impl Layer<'_> {
                     Some(*k),
                 )
             }
-            (Shape::Round(..), Some(_)) => {
+            // A disk inside a sphere (centre c, radius ρ): its rim's point
+            // farthest from c is R u from the centre, u = w/|w|, w = d − (d·e)e
+            // (d = S − c), at |d|² + R² + 2R|w| squared from c; f = (ρ² − that)/(2ρ)
+            // has the distance's zero set, side and gradient on the wall.
+            // (Where d is along e every rim point is as far: the disk lies
+            // against the sphere all round.) Smooth only: the rough rows,
+            // |w| times that point's velocity, take the exact rank test of
+            // B past the derivation's bounds (checked above).
+            (Shape::Round(c, None, big), Some((radius, e))) => {
+                let d = minus(&body.position, c);
+                let along = dot(&d, e);
+                let w = minus(&d, &scale(&along, e));
+                let size = call(Function::Sqrt, sub(dot(&d, &d), square(along)));
+                let far = add([
+                    dot(&d, &d),
+                    square(radius.clone()),
+                    mul([int(2), radius.clone(), size.clone()]),
+                ]);
+                (
+                    div(sub(square(big.clone()), far), mul([int(2), big.clone()])),
+                    scale(radius, &w),
+                    size,
+                    None,
+                )
+            }
+            (Shape::Round(_, Some(_), _), Some(_)) => {
                 self.cx.error(
-                    structure("a disk meets a `plane` wall (not a sphere or cylinder yet)"),
+                    structure("a disk meets a `plane` or a `sphere` wall (not a cylinder: its rim's point farthest from an axis has no closed form)"),
                     Some(span.clone()),
                 );
                 return;
