@@ -42,6 +42,24 @@ fn bodies_give_the_hand_written_models() {
     }
 }
 
+/// A model file without `[model]` is named after its file: the rough ball
+/// of `tests/bodies/ball_wall_euler.toml` with its header removed, written
+/// as `rolling_ball.toml`, is `rolling_ball` and derives what the
+/// hand-written file does.
+#[test]
+fn a_file_without_a_header_is_named_after_itself() {
+    let text = std::fs::read_to_string("tests/bodies/ball_wall_euler.toml").unwrap();
+    let text = text.replace("[model]\nname = \"ball_wall_euler\"\n", "");
+    assert!(!text.contains("[model]"));
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("unnamed");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("rolling_ball.toml");
+    std::fs::write(&file, &text).unwrap();
+    let d = derive(&file).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(d.model.name, "rolling_ball");
+    same_model("rolling_ball", &d, &derived("models", "ball_wall_euler"));
+}
+
 /// A coin rolling on the floor (`disk` as its contact shape): its rolling
 /// rows, found from the rim's point nearest the floor with no root (the
 /// centre's height R sin θ stands for R|n − (n·e)e|), derive exactly what

@@ -7,7 +7,8 @@ use toml::Spanned;
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct File {
-    pub(super) model: Spanned<Header>,
+    /// Absent: the model is named after its file.
+    pub(super) model: Option<Spanned<Header>>,
     #[serde(default)]
     pub(super) parameters: IndexMap<Spanned<String>, Spanned<ParamDecl>>,
     pub(super) coordinates: Option<Spanned<Names>>,
@@ -33,7 +34,8 @@ pub(super) struct File {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct Header {
-    pub(super) name: Spanned<String>,
+    /// Absent: the file's name without `.toml`.
+    pub(super) name: Option<Spanned<String>>,
     #[serde(default)]
     pub(super) doc: String,
     pub(super) projector: Option<Spanned<String>>,

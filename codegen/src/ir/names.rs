@@ -29,24 +29,7 @@ impl Validator<'_> {
     }
 
     pub(super) fn check_ident(&mut self, name: &str, span: Range<usize>, symbol: bool) {
-        let why = if name.is_empty() {
-            Some("it is empty".to_string())
-        } else if !name.starts_with(|c: char| c.is_ascii_alphabetic()) {
-            Some("a name starts with a letter".into())
-        } else if !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
-            Some("a name has only ASCII letters, digits and `_`".into())
-        } else if name.ends_with('_') {
-            Some("a name may not end with `_`".into())
-        } else if name.contains("__") {
-            Some("a name may not contain `__`".into())
-        } else if RUST_KEYWORDS.contains(&name) {
-            Some("it is a Rust keyword".into())
-        } else if symbol && RESERVED.contains(&name) {
-            Some("it is reserved (a function, a constant or a name the generated code uses)".into())
-        } else {
-            None
-        };
-        if let Some(why) = why {
+        if let Some(why) = ident_problem(name, symbol) {
             self.cx.error(
                 ErrorKind::BadName {
                     name: name.to_string(),
@@ -85,6 +68,28 @@ impl Validator<'_> {
             base,
             node,
         }
+    }
+}
+
+/// Why `name` cannot name something of the model (a `symbol` also not a
+/// reserved name), if it cannot.
+pub(super) fn ident_problem(name: &str, symbol: bool) -> Option<String> {
+    if name.is_empty() {
+        Some("it is empty".to_string())
+    } else if !name.starts_with(|c: char| c.is_ascii_alphabetic()) {
+        Some("a name starts with a letter".into())
+    } else if !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+        Some("a name has only ASCII letters, digits and `_`".into())
+    } else if name.ends_with('_') {
+        Some("a name may not end with `_`".into())
+    } else if name.contains("__") {
+        Some("a name may not contain `__`".into())
+    } else if RUST_KEYWORDS.contains(&name) {
+        Some("it is a Rust keyword".into())
+    } else if symbol && RESERVED.contains(&name) {
+        Some("it is reserved (a function, a constant or a name the generated code uses)".into())
+    } else {
+        None
     }
 }
 

@@ -13,6 +13,7 @@ use super::limits::{
     self, MAX_DEFINITIONS, MAX_EXPANDED_DEPTH, MAX_EXPANDED_SIZE, MAX_NESTED_DIVISIONS,
     MAX_PARAMETERS, MAX_TERMS,
 };
+use super::names::ident_problem;
 use super::number::rational;
 use super::order::{dependency_order, reaches};
 use super::{Expr, GENERATED_TYPE_NAMES, Kind, Model, Param, ProjectorMode, Wall, camel};
@@ -27,31 +28,53 @@ pub(super) struct Validator<'a> {
 
 impl Validator<'_> {
     pub(super) fn model(&mut self, path: &Path, file: File) -> Option<Model> {
-        let header = file.model.into_inner();
-        let name = header.name.get_ref().clone();
-        self.check_ident(&name, header.name.span(), false);
-        if name.chars().any(|c| c.is_ascii_uppercase()) {
-            self.cx.error(
-                ErrorKind::BadName {
-                    name: name.clone(),
-                    why: "a model's name is snake_case (lower case, digits and `_`)".into(),
-                },
-                Some(header.name.span()),
-            );
-        } else if GENERATED_TYPE_NAMES.contains(&camel(&name).as_str()) {
-            self.cx.error(
-                ErrorKind::BadName {
-                    name: name.clone(),
-                    why: format!(
+        let header = file.model.map(Spanned::into_inner);
+        let (doc, projector) = match &header {
+            Some(h) => (h.doc.trim().to_string(), h.projector.clone()),
+            None => (String::new(), None),
+        };
+        let written = header.and_then(|h| h.name);
+        // Where errors that have no place of their own go: the name, else
+        // the file's start.
+        let name_span = written.as_ref().map_or(0..0, |n| n.span());
+        let name = match &written {
+            Some(n) => n.get_ref().clone(),
+            None => path
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+        };
+        // The file's own name gets the same checks, and says where it came from.
+        let from_file = |why: String| match &written {
+            Some(_) => why,
+            None => {
+                format!("{why} (the model is named after its file: name it with `[model] name`)")
+            }
+        };
+        let why = ident_problem(&name, false)
+            .or_else(|| {
+                (name.chars().any(|c| c.is_ascii_uppercase()))
+                    .then(|| "a model's name is snake_case (lower case, digits and `_`)".into())
+            })
+            .or_else(|| {
+                GENERATED_TYPE_NAMES.contains(&camel(&name).as_str()).then(|| {
+                    format!(
                         "the model's type would be `{}`, a name the generated code already uses",
                         camel(&name)
-                    ),
+                    )
+                })
+            });
+        if let Some(why) = why {
+            self.cx.error(
+                ErrorKind::BadName {
+                    name: name.clone(),
+                    why: from_file(why),
                 },
-                Some(header.name.span()),
+                written.as_ref().map(|n| n.span()),
             );
         }
 
-        let projector = self.projector_mode(header.projector.as_ref());
+        let projector = self.projector_mode(projector.as_ref());
         let (params, derived) = self.params(&file.parameters);
         let (kind, coordinates, velocities) =
             self.variables(file.coordinates.as_ref(), file.velocities.as_ref());
@@ -68,7 +91,7 @@ impl Validator<'_> {
 
         let (dyn_span, dynamics) = match file.dynamics {
             Some(d) => (d.span(), d.into_inner()),
-            None => (header.name.span(), Default::default()),
+            None => (name_span.clone(), Default::default()),
         };
         let kinetic_energy = match &dynamics.kinetic_energy {
             Some(t) => self.expr(t),
@@ -125,7 +148,7 @@ impl Validator<'_> {
             self.initial_values(&params, &derived_names, &definitions, initial, state_len);
         Some(Model {
             name,
-            doc: header.doc.trim().to_string(),
+            doc,
             params,
             derived: derived_names,
             kind,
