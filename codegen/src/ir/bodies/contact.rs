@@ -474,10 +474,11 @@ impl Layer<'_> {
                     Some(*k),
                 )
             }
-            // A disk inside a sphere (centre c, radius ρ): its rim's point
-            // farthest from c is R u from the centre, u = w/|w|, w = d − (d·e)e
-            // (d = S − c), at |d|² + R² + 2R|w| squared from c; f = (ρ² − that)/(2ρ)
-            // has the distance's zero set, side and gradient on the wall.
+            // A disk (radius ρ, axis e) inside a sphere (centre c, radius R):
+            // its rim's point farthest from c is ρ u from the centre, u = w/|w|,
+            // w = d − (d·e)e (d = S − c), at |d|² + ρ² + 2ρ|w| squared from c;
+            // f = (R² − that)/(2R) has the distance's zero set, side and
+            // gradient on the wall.
             // (Where d is along e every rim point is as far: the disk lies
             // against the sphere all round.) Smooth only: the rough rows,
             // |w| times that point's velocity, take the exact rank test of
