@@ -11,7 +11,7 @@ use std::ops::Range;
 
 use symbolica::prelude::*;
 
-use super::is_zero;
+use super::{Rat, is_zero};
 use crate::diag::{Collector, ErrorKind, Reported};
 
 /// Most terms one expansion in the derivation may produce, by the bound of
@@ -171,7 +171,42 @@ pub fn determinant_terms(g: &[Vec<Atom>]) -> f64 {
         .iter()
         .map(|row| row.iter().map(term_count).collect())
         .collect();
-    blocks(&counts)
+    estimate(&counts)
+}
+
+/// The estimate for the matrix [[G, Bᵀ], [B, 0]], whose determinant is
+/// ±det G · det(BG⁻¹Bᵀ): the denominator that a closed-form P = G⁻¹Bᵀ
+/// (BG⁻¹Bᵀ)⁻¹B divides by. B's entries count by their numerators' terms
+/// (a row's entries share its denominator, which the determinant does not
+/// multiply out).
+pub fn bordered_terms(g: &[Vec<Atom>], b: &[Vec<Rat>]) -> f64 {
+    let (n, k) = (g.len(), b.len());
+    let mut counts = vec![vec![Some(0); n + k]; n + k];
+    for (i, row) in g.iter().enumerate() {
+        for (j, a) in row.iter().enumerate() {
+            counts[i][j] = term_count(a);
+        }
+    }
+    for (r, row) in b.iter().enumerate() {
+        for (j, x) in row.iter().enumerate() {
+            let c = if x.numerator.is_zero() {
+                Some(0)
+            } else if x.numerator.is_constant() {
+                None
+            } else {
+                Some(x.numerator.nterms() as u64)
+            };
+            counts[n + r][j] = c;
+            counts[j][n + r] = c;
+        }
+    }
+    estimate(&counts)
+}
+
+/// The largest block's bound, from the entries' term counts (`None` for a
+/// plain number).
+fn estimate(counts: &[Vec<Option<u64>>]) -> f64 {
+    blocks(counts)
         .iter()
         .filter(|block| {
             !block

@@ -329,7 +329,8 @@ pub struct Exact {
     pub field: Field,
     /// Rows of A.
     pub a: Vec<Vec<Rat>>,
-    /// P is solved at run time from G and B rather than derived.
+    /// G⁻¹ is not derived: every wall's P is solved at run time from G
+    /// and B (with G⁻¹ exact, a wall may still be, by its own estimate).
     pub structured: bool,
 }
 

@@ -5,7 +5,7 @@
 
 use symbolica::prelude::*;
 
-use super::budget::Over;
+use super::budget::{self, Over};
 use super::build::Differentiate;
 use super::checks::{self, WallRows};
 use super::elimination;
@@ -15,7 +15,7 @@ use super::output::{Form, Function, Geometry, Projection, WallDerivation};
 use super::symbols::Symbols;
 use super::{Field, Rat, is_zero, rows_matrix, strings};
 use crate::diag::{Collector, ErrorKind, Reported};
-use crate::ir::{Kind, Wall};
+use crate::ir::{Kind, ProjectorMode, Wall};
 use crate::program::{Entry, stored_signs};
 use crate::quantity::Quantity;
 
@@ -61,7 +61,16 @@ fn wall(
     };
     let (b_mat, b_atoms, kept, dropped, steady) =
         (b.matrix, b.atoms, b.origin, b.dropped, b.steady);
-    if !steady && c.g_inv.is_none() {
+    // `auto` weighs B too: a closed-form P divides by det(BG⁻¹Bᵀ), and a
+    // wall whose estimate is past the budget is solved at run time (where
+    // the kept rows span the rest everywhere; elsewhere only the closed
+    // form is right).
+    let g_inv = c.g_inv.filter(|_| {
+        sym.model.projector != ProjectorMode::Auto
+            || !steady
+            || budget::bordered_terms(&c.exact.g, &b.rats) <= budget::MAX_DETERMINANT_TERMS
+    });
+    if !steady && g_inv.is_none() {
         return Err(cx.error(
             ErrorKind::Structure(format!(
                 "wall `{}`: the rows of B kept ({}) become dependent where the removed ones ({}) do not, so P solved from them at run time would be wrong there; derive P exactly (`projector = \"symbolic\"`) or write rows that stay independent on the wall",
@@ -72,7 +81,7 @@ fn wall(
             span.clone(),
         ));
     }
-    let closed = match c.g_inv {
+    let closed = match g_inv {
         Some(g_inv) => Some(
             (closed_form(sym, low, g_inv, &b_mat))
                 .map_err(|o| reduced(o, cx, &w.span, "the projector P"))?
@@ -178,6 +187,8 @@ fn wall(
 /// A wall's B: its independent rows and where they came from.
 struct WallB {
     matrix: Matrix<Field>,
+    /// The rows as rational functions.
+    rats: Vec<Vec<Rat>>,
     /// The rows as expressions, functions raised.
     atoms: Vec<Vec<Atom>>,
     origin: Vec<String>,
@@ -249,6 +260,7 @@ fn rows(
     }
     Ok(Some(WallB {
         matrix,
+        rats: b,
         atoms,
         origin: kept.into_iter().map(|(_, o)| o).collect(),
         dropped,

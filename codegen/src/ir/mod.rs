@@ -169,8 +169,9 @@ pub enum Kind {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ProjectorMode {
     /// Symbolic while G is sparse (at most 2n non-zero entries off the
-    /// diagonal: any n ≤ 3, or a G that couples few velocities), structured
-    /// otherwise.
+    /// diagonal: any n ≤ 3, or a G that couples few velocities) and det G
+    /// is within the budget, structured otherwise; and, with G⁻¹ exact,
+    /// structured for a wall whose det(BG⁻¹Bᵀ) is past the budget.
     Auto,
     /// P and (I − 2P)v derived exactly and emitted as closed forms.
     Symbolic,
