@@ -150,7 +150,8 @@ fn tangents_by_the_parameters_past_the_bound_are_left_out_alone() {
 }
 
 /// `derive` of a model written with bodies shows what the bodies layer
-/// derived, each with the line of its declaration, before G.
+/// derived, each with the line of its declaration, before G: the
+/// coordinates too, which this file leaves to the body.
 #[test]
 fn derive_shows_what_the_bodies_derive() {
     let model =
@@ -165,12 +166,13 @@ fn derive_shows_what_the_bodies_derive() {
     let shown = text.find("derived from the bodies").expect(&text);
     assert!(shown < text.find("G =").unwrap(), "{text}");
     for line in [
-        "  ball_wy = theta_dot*sin(phi) - psi_dot*cos(phi)*sin(theta)   (line 16)",
-        "  T = J*(ball_wx^2 + ball_wy^2 + ball_wz^2)/2   (line 15)",
-        "  V = m*(a*x + g*r)   (line 15)",
-        "  row of A = x_dot - ball_wy*r   (line 26)",
-        "  wall `wall` surface = x - r   (line 30)",
-        "  wall `wall` contact row = y_dot - ball_wz*r   (line 30)",
+        "  coordinates = x, y, phi, theta, psi   (line 14)",
+        "  ball_wy = theta_dot*sin(phi) - psi_dot*cos(phi)*sin(theta)   (line 15)",
+        "  T = J*(ball_wx^2 + ball_wy^2 + ball_wz^2)/2   (line 14)",
+        "  V = m*(a*x + g*r)   (line 14)",
+        "  row of A = x_dot - ball_wy*r   (line 25)",
+        "  wall `wall` surface = x - r   (line 28)",
+        "  wall `wall` contact row = y_dot - ball_wz*r   (line 28)",
     ] {
         assert!(
             text.lines().any(|l| l == line),

@@ -89,7 +89,8 @@ pub(super) struct WallDecl {
     pub(super) normal_velocity: Option<Spanned<String>>,
     #[serde(default)]
     pub(super) contact: Vec<Spanned<String>>,
-    /// With bodies: the body that meets the wall.
+    /// With bodies: the body that meets the wall (absent with a shape:
+    /// the model's only body).
     pub(super) body: Option<Spanned<String>>,
     /// With bodies: the wall's shape, one of these three.
     pub(super) plane: Option<Spanned<PlaneDecl>>,
@@ -178,7 +179,8 @@ pub(super) struct RoundDecl {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RollingDecl {
-    pub(super) body: Spanned<String>,
+    /// Absent: the model's only body.
+    pub(super) body: Option<Spanned<String>>,
     pub(super) plane: Option<Spanned<PlaneDecl>>,
     pub(super) sphere: Option<Spanned<RoundDecl>>,
     pub(super) cylinder: Option<Spanned<RoundDecl>>,
@@ -211,7 +213,8 @@ pub(super) struct EndDecl {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct KnifeEdgeDecl {
-    pub(super) body: Spanned<String>,
+    /// Absent: the model's only body.
+    pub(super) body: Option<Spanned<String>>,
     pub(super) blade: Spanned<Vec<Spanned<Number>>>,
     pub(super) normal: Spanned<Vec<Spanned<Number>>>,
 }

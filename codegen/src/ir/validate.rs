@@ -76,8 +76,11 @@ impl Validator<'_> {
 
         let projector = self.projector_mode(projector.as_ref());
         let (params, derived) = self.params(&file.parameters);
-        let (kind, coordinates, velocities) =
-            self.variables(file.coordinates.as_ref(), file.velocities.as_ref());
+        let (kind, coordinates, velocities) = self.variables(
+            file.coordinates.as_ref(),
+            file.velocities.as_ref(),
+            !file.body.is_empty(),
+        );
         for name in file.definitions.keys() {
             self.declare(name, "definition");
         }
@@ -248,6 +251,7 @@ impl Validator<'_> {
         &mut self,
         coords: Option<&Spanned<Names>>,
         vels: Option<&Spanned<Names>>,
+        bodies: bool,
     ) -> (Kind, Vec<String>, Vec<String>) {
         match (coords, vels) {
             (Some(c), None) => {
@@ -267,6 +271,9 @@ impl Validator<'_> {
                 );
                 (Kind::Coordinates, Vec::new(), Vec::new())
             }
+            // Bodies whose coordinates could not be found: the bodies
+            // layer has said why.
+            (None, None) if bodies => (Kind::Coordinates, Vec::new(), Vec::new()),
             (None, None) => {
                 self.cx.error(
                     ErrorKind::Structure(
@@ -504,9 +511,14 @@ impl Validator<'_> {
                 self.cx.error(kind, Some(w.name.span()));
             }
             match (kind, &w.surface, &w.normal_velocity) {
-                // A wall met by a body whose shape could not be read: the
+                // A wall met by a body (named, or the only one) or given
+                // by shape, whose shape or body could not be read: the
                 // bodies layer has said why.
-                (Kind::Coordinates, None, _) if w.body.is_some() => {}
+                (Kind::Coordinates, None, _)
+                    if w.body.is_some()
+                        || w.plane.is_some()
+                        || w.sphere.is_some()
+                        || w.cylinder.is_some() => {}
                 (Kind::Coordinates, None, _) => {
                     self.cx.error(
                         ErrorKind::Structure(format!(

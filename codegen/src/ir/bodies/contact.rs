@@ -37,6 +37,26 @@ impl Layer<'_> {
         self.bodies.get(body.get_ref()).cloned()
     }
 
+    /// The name of the model's only body, for a declaration at `at` that
+    /// names none; an error there when there are several.
+    pub(super) fn only_body(&mut self, at: Range<usize>) -> Option<Spanned<String>> {
+        let mut names: Vec<&String> = self.declared_bodies.iter().collect();
+        if let [only] = names[..] {
+            return Some(Spanned::new(at, only.clone()));
+        }
+        names.sort();
+        let list: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
+        self.cx.error(
+            structure(format!(
+                "the model has {} bodies ({}): name the `body` this is for",
+                names.len(),
+                list.join(", ")
+            )),
+            Some(at),
+        );
+        None
+    }
+
     /// A plane's unit normal, offset and the axis of its largest component.
     fn plane(&mut self, p: &Spanned<PlaneDecl>) -> Option<(Vec3, Sym, usize)> {
         let n = self.vector(&p.get_ref().normal)?;
@@ -167,7 +187,10 @@ impl Layer<'_> {
         let Some(shape) = self.shape(&r.plane, &r.sphere, &r.cylinder) else {
             return;
         };
-        let Some(body) = self.find(&r.body) else {
+        let Some(name) = r.body.clone().or_else(|| self.only_body(decl.span())) else {
+            return;
+        };
+        let Some(body) = self.find(&name) else {
             return;
         };
         if let Some((radius, axis)) = &body.disk {
@@ -188,12 +211,12 @@ impl Layer<'_> {
             return;
         }
         let Some(radius) = body.radius.clone() else {
-            let id = r.body.get_ref().clone();
+            let id = name.get_ref().clone();
             self.cx.error(
                 structure(format!(
                     "body `{id}` rolls, so it needs a contact shape: `radius` (a sphere) or `disk`"
                 )),
-                Some(r.body.span()),
+                Some(name.span()),
             );
             return;
         };
@@ -386,7 +409,10 @@ impl Layer<'_> {
         if self.unit_vector(&n, d.normal.span()).is_none() {
             return;
         }
-        let Some(body) = self.find(&d.body) else {
+        let Some(name) = d.body.clone().or_else(|| self.only_body(decl.span())) else {
+            return;
+        };
+        let Some(body) = self.find(&name) else {
             return;
         };
         let across = cross(&n, &frames::apply(&body.rotation, &blade));
@@ -407,13 +433,11 @@ impl Layer<'_> {
         let shapes = usize::from(w.plane.is_some())
             + usize::from(w.sphere.is_some())
             + usize::from(w.cylinder.is_some());
+        // A wall by shape is met by the body it names, or by the only one.
+        if w.body.is_none() && (shapes > 0 || w.law.is_some()) {
+            w.body = self.only_body(span.clone());
+        }
         let Some(body_name) = w.body.clone() else {
-            if shapes > 0 || w.law.is_some() {
-                self.cx.error(
-                    structure("a wall given by shape (`plane`, `sphere`, `cylinder`, `law`) names the `body` that meets it"),
-                    Some(span),
-                );
-            }
             return;
         };
         if shapes != 1 || w.surface.is_some() || !w.contact.is_empty() {

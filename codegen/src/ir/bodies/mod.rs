@@ -47,7 +47,8 @@ use std::ops::Range;
 use toml::Spanned;
 
 use super::expr::parse;
-use super::file::{Dynamics, File, Number};
+use super::file::{Dynamics, File, Names, Number};
+use super::names::ident_problem;
 use crate::diag::{Collector, ErrorKind};
 use frames::Vec3;
 use sym::{Sym, add, mul, name};
@@ -58,10 +59,14 @@ pub(super) fn expand(file: &mut File, cx: &mut Collector) -> Vec<FromBodies> {
         refuse_without_bodies(file, cx);
         return Vec::new();
     }
+    let inferred = file.coordinates.is_none() && file.velocities.is_none();
+    if inferred {
+        file.coordinates = coordinates_of_bodies(file);
+    }
     let Some(coordinates) = file.coordinates.as_ref() else {
         let at = file.body[0].span();
         cx.error(
-            structure("bodies move with coordinates: declare [coordinates]"),
+            structure("bodies move with coordinates: declare [coordinates] (no body's position or attitude names one whole)"),
             Some(at),
         );
         return Vec::new();
@@ -126,11 +131,21 @@ pub(super) fn expand(file: &mut File, cx: &mut Collector) -> Vec<FromBodies> {
         text: t.get_ref().clone(),
         span: t.span(),
     };
-    let mut record: Vec<FromBodies> = out
-        .definitions
-        .iter()
-        .map(|(n, t)| shown(n.get_ref(), t))
-        .collect();
+    let mut record: Vec<FromBodies> = Vec::new();
+    if let Some(c) = file.coordinates.as_ref().filter(|_| inferred) {
+        let names: Vec<&str> = c
+            .get_ref()
+            .names
+            .iter()
+            .map(|n| n.get_ref().as_str())
+            .collect();
+        record.push(FromBodies {
+            what: "coordinates".into(),
+            text: names.join(", "),
+            span: c.span(),
+        });
+    }
+    record.extend(out.definitions.iter().map(|(n, t)| shown(n.get_ref(), t)));
     record.extend(out.kinetic.iter().map(|t| shown("T", t)));
     record.extend(out.potential.iter().map(|t| shown("V", t)));
     record.extend(out.holonomic.iter().map(|t| shown("holonomic h", t)));
@@ -356,6 +371,55 @@ impl Layer<'_> {
         ));
         name(&n)
     }
+}
+
+/// Without `[coordinates]`, a body model moves with the names its bodies'
+/// positions and attitudes give whole (a position entry `"x"`, an angle,
+/// an Euler angle, a quaternion component), in the order written, each
+/// once, parameters and definitions left out: a name inside an expression
+/// (`"R*sin(theta)"`) is not one (it must be declared, or be given whole
+/// elsewhere). `None` when there is no such name.
+fn coordinates_of_bodies(file: &File) -> Option<Spanned<Names>> {
+    let known: HashSet<&str> = (file.parameters.keys())
+        .chain(file.definitions.keys())
+        .map(|n| n.get_ref().as_str())
+        .collect();
+    let mut names: Vec<Spanned<String>> = Vec::new();
+    let mut take = |text: &str, at: Range<usize>| {
+        let text = text.trim();
+        let fresh = !names.iter().any(|n| n.get_ref() == text);
+        if fresh && !known.contains(text) && ident_problem(text, true).is_none() {
+            names.push(Spanned::new(at, text.to_string()));
+        }
+    };
+    for body in &file.body {
+        let body = body.get_ref();
+        for entry in body.position.get_ref() {
+            if let Number::Text(t) = entry.get_ref() {
+                take(t, entry.span());
+            }
+        }
+        let Some(o) = &body.orientation else {
+            continue;
+        };
+        let o = o.get_ref();
+        let angles = (o.angles.iter())
+            .chain(&o.quaternion)
+            .flat_map(|a| a.get_ref());
+        for n in o.angle.iter().chain(angles) {
+            take(n.get_ref(), n.span());
+        }
+    }
+    let at = file.body.first()?.span();
+    (!names.is_empty()).then(|| {
+        Spanned::new(
+            at,
+            Names {
+                names,
+                velocities: None,
+            },
+        )
+    })
 }
 
 /// Without bodies, the declarations that need them are refused.
