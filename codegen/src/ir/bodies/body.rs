@@ -41,28 +41,24 @@ impl Layer<'_> {
             );
             return;
         }
-        let Some(mass) = self.sym(&b.mass) else {
-            return;
-        };
-        self.positive(&mass, "the mass", b.mass.span());
-        let Some(position) = self.vector(&b.position) else {
-            return;
-        };
-        if !position
-            .iter()
-            .all(|p| self.positional(p, "the position", b.position.span()))
-        {
-            return;
+        // Each part is read, so that the mistakes of all are reported.
+        let mass = self.sym(&b.mass);
+        if let Some(m) = &mass {
+            self.positive(m, "the mass", b.mass.span());
         }
-        let inertia = match &b.inertia {
-            Some(i) => match self.inertia(i) {
-                Some(i) => Some(i),
-                None => return,
-            },
-            None => None,
-        };
-        let Some(attitude) = self.attitude(b) else {
+        let position = self.vector(&b.position).filter(|p| {
+            p.iter()
+                .all(|x| self.positional(x, "the position", b.position.span()))
+        });
+        let inertia = b.inertia.as_ref().map(|i| self.inertia(i));
+        let attitude = self.attitude(b);
+        let (Some(mass), Some(position), Some(attitude)) = (mass, position, attitude) else {
             return;
+        };
+        let inertia = match inertia {
+            Some(None) => return,
+            Some(i) => i,
+            None => None,
         };
         if inertia.is_none() && !matches!(attitude, Attitude::Fixed) {
             self.cx.error(

@@ -271,12 +271,28 @@ impl Layer<'_> {
     fn sym_text(&mut self, text: &str, span: Range<usize>) -> Option<Sym> {
         match parse(text) {
             Ok(node) => {
-                let mut left_out = None;
+                let (mut left_out, mut unknown) = (None, Vec::new());
                 node.visit_names(&mut |x, _| {
                     if self.unexpanded.contains(x) {
                         left_out.get_or_insert_with(|| x.to_string());
                     }
+                    if !self.declared.contains(x) && !unknown.iter().any(|u| u == x) {
+                        unknown.push(x.to_string());
+                    }
                 });
+                // A name nothing declares would be taken for a constant
+                // (a rotor's own angle left out of [coordinates] would not
+                // turn): it is refused here, since what the layer derives
+                // from it may no longer contain it.
+                for name in &unknown {
+                    self.cx.error(
+                        ErrorKind::UnknownName { name: name.clone() },
+                        Some(span.clone()),
+                    );
+                }
+                if !unknown.is_empty() {
+                    return None;
+                }
                 if let Some(x) = left_out {
                     self.cx.error(
                         structure(format!(
