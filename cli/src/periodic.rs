@@ -191,7 +191,7 @@ fn failure<M: Surfaces<N>, const N: usize>(
             residual,
             normal_velocity,
         } => format!(
-            "after {iterations} Newton steps (residual {residual:.3e}) the search heads for motions that slide along `{wall}` instead of leaving it: its last full step landed where the normal velocity is not positive, and the normal velocity at the last state is {normal_velocity:.3e}; no orbit through collisions nearby (more --iterations will not help; try another start with --set)"
+            "after {iterations} Newton steps (residual {residual:.3e}) the search heads for motions that slide along `{wall}` or rest against it instead of leaving it: the normal velocity at the last state is {normal_velocity:.3e}; no orbit through collisions nearby (more --iterations will not help; try another start with --set)"
         ),
         PeriodicError::SingularJacobian { iterations } => format!(
             "the return map's Jacobian minus I vanishes on the section after {iterations} steps: Newton's method has no direction"

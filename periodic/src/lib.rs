@@ -190,12 +190,12 @@ pub enum PeriodicError<W> {
     },
     /// Newton's method stopped (as [`PeriodicError::NoConvergence`] or
     /// [`PeriodicError::Stalled`] would say) while heading for a state
-    /// that does not leave the wall: its last full step landed where the
-    /// normal velocity is not positive, so it could only be taken in part,
-    /// and the normal velocity of the state reached is below
-    /// [`GRAZING`] of the velocity's size. The states it approaches move
-    /// along the wall, not through collisions with it; more steps do not
-    /// help.
+    /// that does not leave the wall: the normal velocity of the state
+    /// reached is below [`GRAZING`] of the velocity's size (often its full
+    /// steps land where the normal velocity is not positive, so they are
+    /// taken in part; or the return map loses its accuracy as the impacts
+    /// fade). The states it approaches move along the wall, or rest
+    /// against it, not through collisions with it; more steps do not help.
     TowardsGrazing {
         /// Steps taken.
         iterations: usize,
@@ -271,17 +271,24 @@ pub fn find<M: TaylorSeries<N>, const N: usize>(
     let mut x = onto_section(model, start, section, search.settings)?;
     x.t = 0.0;
     let angles = search.angles;
+    let scale = |x: &State<N>| norm_inf(&x.q).max(norm_inf(&x.v)).max(1.0);
     let residual_of = |x: &State<N>, r: &Return<N>| {
-        let scale = norm_inf(&x.q).max(norm_inf(&x.v)).max(1.0);
         let d = difference(&r.state, x, angles);
-        d.iter().fold(0.0_f64, |m, e| m.max(e.abs())) / scale
+        d.iter().fold(0.0_f64, |m, e| m.max(e.abs())) / scale(x)
+    };
+    // What a step must lower: |Π(x) − x|₂, for which the least-squares
+    // step below is a descent direction. (Its ∞-norm need not fall: the
+    // step moves x in the section only, and where (DΠ − I)Z has no full
+    // rank, or more rows than columns, the part of the residual outside
+    // its range stays, and may be the largest component. Judged by the
+    // ∞-norm, §3.1's ball in Euler angles stalled at 1.15 after 2 steps.)
+    let merit_of = |x: &State<N>, r: &Return<N>| {
+        let d = difference(&r.state, x, angles);
+        d.iter().map(|e| e * e).sum::<f64>().sqrt()
     };
     let mut iterations = 0;
-    // Whether the last full Newton step landed where the motion does not
-    // leave the wall.
-    let mut full_step_grazes = false;
-    let stopped = |x: &State<N>, full_step_grazes: bool, iterations, residual, stalled: bool| {
-        if full_step_grazes && nearly_grazes(model, x, section.wall) {
+    let stopped = |x: &State<N>, iterations, residual, stalled: bool| {
+        if nearly_grazes(model, x, section.wall) {
             PeriodicError::TowardsGrazing {
                 iterations,
                 residual,
@@ -302,6 +309,7 @@ pub fn find<M: TaylorSeries<N>, const N: usize>(
     loop {
         let map = return_map(model, x, section, search.settings, Some(search.rtol))?;
         let residual = residual_of(&x, &map);
+        let merit = merit_of(&x, &map);
         let jacobian = map.jacobian.expect("asked for");
         if residual <= search.tolerance {
             let z = section_basis(model, &x, section.wall)?;
@@ -320,7 +328,7 @@ pub fn find<M: TaylorSeries<N>, const N: usize>(
             });
         }
         if iterations == search.max_iterations {
-            return Err(stopped(&x, full_step_grazes, iterations, residual, false));
+            return Err(stopped(&x, iterations, residual, false));
         }
         iterations += 1;
         let z = section_basis(model, &x, section.wall)?;
@@ -343,21 +351,16 @@ pub fn find<M: TaylorSeries<N>, const N: usize>(
         // residual.
         for _ in 0..=search.halvings {
             let trial = restore(model, &x, &dx, lambda, section.wall);
-            if lambda == 1.0 {
-                full_step_grazes = trial
-                    .as_ref()
-                    .is_ok_and(|t| !leaves(model, t, section.wall));
-            }
             if let Ok(trial) = trial
                 && let Ok(map) = return_map(model, trial, section, search.settings, None)
-                && residual_of(&trial, &map) < residual
+                && merit_of(&trial, &map) < merit
             {
                 accepted = Some(trial);
                 break;
             }
             lambda *= 0.5;
         }
-        x = accepted.ok_or_else(|| stopped(&x, full_step_grazes, iterations, residual, true))?;
+        x = accepted.ok_or_else(|| stopped(&x, iterations, residual, true))?;
     }
 }
 
@@ -369,12 +372,6 @@ pub const GRAZING: f64 = 1e-3;
 /// |df|·max(1, |q̇|∞) at `x`: the scale of its normal velocity.
 fn normal_scale<M: Surfaces<N>, const N: usize>(model: &M, x: &State<N>, wall: M::Wall) -> f64 {
     norm(&model.normal(wall, &x.q)) * norm_inf(&x.v).max(1.0)
-}
-
-/// Whether the motion from `x` (on the wall) leaves it: a normal velocity
-/// above rounding of its scale.
-fn leaves<M: Surfaces<N>, const N: usize>(model: &M, x: &State<N>, wall: M::Wall) -> bool {
-    model.normal_velocity(wall, &x.q, &x.v) > 1e-9 * normal_scale(model, x, wall)
 }
 
 /// Whether `x`'s normal velocity is below [`GRAZING`] of its scale.
