@@ -88,7 +88,7 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
         },
     };
     let g_flat: Vec<Atom> = exact.g.iter().flatten().cloned().collect();
-    let mass_matrix = compile.program(cx, Quantity::MassMatrix, &g_flat, 0, t_span)?;
+    let mass_matrix = compile.program(cx, Quantity::MassMatrix, &[&g_flat], 0, t_span)?;
     checks::positive_definite(&sym, &raw, cx, &mass_matrix.program);
     let g_inv = exact.inverse(&sym, cx)?;
     let context = walls::Context {
@@ -108,19 +108,28 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
     let v_span = model.potential.as_ref().map_or(t_span, |v| &v.span);
     let reduced_v =
         (low.reduce(&raw.v)).map_err(|o| o.report(cx, v_span, &lower::reduced("the potential")))?;
-    for (quantity, outputs, rows) in [
-        (Quantity::KineticEnergy, vec![reduced_t], 0),
-        (Quantity::Potential, vec![reduced_v], 0),
-        (Quantity::Constraints, a_flat, raw.a_rows.len()),
+    // A's rows and their rates as written, or reduced where that is
+    // cheaper: a rolling disk's rows divide by its centre's height, which
+    // the reduction cancels.
+    let or_reduced = |outputs: Vec<Atom>| {
+        let reduced: Option<Vec<Atom>> = outputs.iter().map(|a| low.reduce(a).ok()).collect();
+        let reduced = reduced.filter(|r| *r != outputs);
+        std::iter::once(outputs).chain(reduced).collect::<Vec<_>>()
+    };
+    for (quantity, forms, rows) in [
+        (Quantity::KineticEnergy, vec![vec![reduced_t]], 0),
+        (Quantity::Potential, vec![vec![reduced_v]], 0),
+        (Quantity::Constraints, or_reduced(a_flat), raw.a_rows.len()),
         (
             Quantity::Holonomic,
-            raw.holonomic.clone(),
+            vec![raw.holonomic.clone()],
             raw.holonomic.len(),
         ),
-        (Quantity::Forcing, raw.forcing.clone(), 0),
-        (Quantity::ConstraintDrift, raw.drift.clone(), 0),
+        (Quantity::Forcing, vec![raw.forcing.clone()], 0),
+        (Quantity::ConstraintDrift, or_reduced(raw.drift.clone()), 0),
     ] {
-        functions.push(compile.applicable(cx, quantity, &outputs, rows, t_span)?);
+        let forms: Vec<&[Atom]> = forms.iter().map(|f| &f[..]).collect();
+        functions.push(compile.applicable_of(cx, quantity, &forms, rows, t_span)?);
     }
     let mut motion_systems = Vec::new();
     let moving = model.kind == Kind::Coordinates && raw.drift.len() >= raw.a_rows.len();
@@ -386,24 +395,29 @@ impl Blame<'_> {
 }
 
 impl Compiler<'_> {
-    /// The function for `quantity` computing `outputs` (`rows` of them in
-    /// use, for rows and values); a failure is reported at `span`.
+    /// The function for `quantity`: the cheapest program of every form of
+    /// its outputs (`rows` of them in use, for rows and values); a failure
+    /// is reported at `span`.
     fn program(
         &self,
         cx: &mut Collector,
         quantity: Quantity,
-        outputs: &[Atom],
+        forms: &[&[Atom]],
         rows: usize,
         span: &Range<usize>,
     ) -> Result<Function, Reported> {
-        evaluate::programs(outputs, &self.inputs, self.params)
-            .map(|candidates| self.cheapest(quantity, candidates))
-            .map(|program| Function {
-                quantity,
-                program,
-                rows,
-            })
-            .map_err(|e| cx.error(ErrorKind::Symbolic(e), Some(self.blame.place(span))))
+        let mut candidates = Vec::new();
+        for outputs in forms {
+            candidates.extend(
+                evaluate::programs(outputs, &self.inputs, self.params)
+                    .map_err(|e| cx.error(ErrorKind::Symbolic(e), Some(self.blame.place(span))))?,
+            );
+        }
+        Ok(Function {
+            quantity,
+            program: self.cheapest(quantity, candidates),
+            rows,
+        })
     }
 
     /// The cheapest of programs that compute the same outputs, the first
@@ -440,10 +454,23 @@ impl Compiler<'_> {
         rows: usize,
         span: &Range<usize>,
     ) -> Result<Option<Function>, Reported> {
+        self.applicable_of(cx, quantity, &[outputs], rows, span)
+    }
+
+    /// As [`Compiler::applicable`], of the cheapest of several forms of
+    /// the same outputs (the first on a tie).
+    pub(crate) fn applicable_of(
+        &self,
+        cx: &mut Collector,
+        quantity: Quantity,
+        forms: &[&[Atom]],
+        rows: usize,
+        span: &Range<usize>,
+    ) -> Result<Option<Function>, Reported> {
         if self.kind == Kind::Instantaneous && !quantity.spec().capability.instantaneous() {
             return Ok(None);
         }
-        self.program(cx, quantity, outputs, rows, span).map(Some)
+        self.program(cx, quantity, forms, rows, span).map(Some)
     }
 }
 
