@@ -392,7 +392,8 @@ impl Layer<'_> {
 /// Without `[coordinates]`, a body model moves with the names its bodies'
 /// positions and attitudes give whole (a position entry `"x"`, an angle,
 /// an Euler angle, a quaternion component), in the order written, each
-/// once, parameters and definitions left out: a name inside an expression
+/// once, parameters, definitions and the velocities of the others
+/// (`x_dot` beside `x`) left out: a name inside an expression
 /// (`"R*sin(theta)"`) is not one (it must be declared, or be given whole
 /// elsewhere). `None` when there is no such name.
 fn coordinates_of_bodies(file: &File) -> Option<Spanned<Names>> {
@@ -426,6 +427,9 @@ fn coordinates_of_bodies(file: &File) -> Option<Spanned<Names>> {
             take(n.get_ref(), n.span());
         }
     }
+    // `x_dot` beside `x` is x's velocity (by default), not a coordinate.
+    let given: Vec<String> = names.iter().map(|n| n.get_ref().clone()).collect();
+    names.retain(|n| !given.iter().any(|g| *n.get_ref() == format!("{g}_dot")));
     let at = file.body.first()?.span();
     (!names.is_empty()).then(|| {
         Spanned::new(
