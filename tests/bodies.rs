@@ -147,6 +147,20 @@ fn a_rough_ball_into_a_wall_in_fifteen_lines() {
         close("P", &pb.concat(), &ph.concat());
         close("v+", &mb.collide(wb, &q, &v), &mh.collide(wh, &q, &v));
     }
+    // With no parameters there is nothing to differentiate by: only the
+    // phase's tangents are generated.
+    let quantities = || {
+        (b.functions.iter())
+            .chain(b.walls.iter().flat_map(|w| &w.functions))
+            .map(|f| f.quantity.spec().name)
+    };
+    assert!(quantities().any(|n| n == "accelerations_tangent"));
+    assert!(quantities().any(|n| n == "collide_tangent"));
+    assert!(
+        !quantities().any(|n| n.ends_with("parameter_tangent")),
+        "{:?}",
+        quantities().collect::<Vec<_>>()
+    );
 }
 
 /// A coin rolling on the floor (`disk` as its contact shape): its rolling

@@ -198,8 +198,9 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
 /// [`crate::MAX_GENERATED_INSTRUCTIONS`], all are left out (the model then
 /// has no derivatives, and its header says why; a model past the bound
 /// without them is refused as before); where only the parameters' would,
-/// those are. Returns the instructions each left-out case would have added:
-/// (all tangents, the parameters' alone).
+/// those are. A model without parameters has no tangents along them.
+/// Returns the instructions each left-out case would have added: (all
+/// tangents, the parameters' alone).
 fn tangents(
     functions: &mut Vec<Function>,
     walls: &mut [WallDerivation],
@@ -250,7 +251,12 @@ fn tangents(
         size(model) + walls.iter().map(|fs| size(fs)).sum::<usize>()
     };
     let phase = group(functions, walls, PHASE);
-    let by_parameters = group(functions, walls, PARAMETERS);
+    let by_parameters = if params == 0 {
+        // Nothing to differentiate by.
+        (Vec::new(), vec![Vec::new(); walls.len()])
+    } else {
+        group(functions, walls, PARAMETERS)
+    };
     let now = size(functions) + walls.iter().map(|w| size(&w.functions)).sum::<usize>();
     let bound = crate::MAX_GENERATED_INSTRUCTIONS;
     let (phase_size, parameters_size) = (total(&phase), total(&by_parameters));

@@ -228,7 +228,16 @@ fn forward(d: &Ctx, spec: &Spec, variants: &[Ident]) -> Option<TokenStream> {
         (params, wrapped(quote! { self.#f(#args) }))
     } else {
         // A wall without the function (a collision map solved at run
-        // time has no tangent program) answers `None`.
+        // time has no tangent program) answers `None`; where no wall has
+        // it, the trait's default does.
+        let none = d
+            .derivation
+            .walls
+            .iter()
+            .all(|w| w.function(spec.quantity).is_none());
+        if none && matches!(wrap, Forward::Some) {
+            return None;
+        }
         let arms = d.derivation.walls.iter().zip(variants).map(|(w, v)| {
             let f = format_ident!("{}_{}", w.name, spec.name);
             let value = match (w.function(spec.quantity), wrap) {
