@@ -82,7 +82,10 @@ pub(super) struct Dynamics {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct WallDecl {
-    pub(super) name: Spanned<String>,
+    /// Absent: `wall`, when it is the model's only wall
+    /// ([`super::name_the_only_wall`] fills it in before anything reads
+    /// it; [`WallDecl::name`]).
+    pub(super) name: Option<Spanned<String>>,
     #[serde(default)]
     pub(super) doc: String,
     pub(super) surface: Option<Spanned<String>>,
@@ -98,6 +101,15 @@ pub(super) struct WallDecl {
     pub(super) cylinder: Option<Spanned<RoundDecl>>,
     /// With bodies: `smooth` (the default) or `rough`.
     pub(super) law: Option<Spanned<String>>,
+}
+
+impl WallDecl {
+    /// Its name, given or the only wall's default.
+    pub(super) fn name(&self) -> &Spanned<String> {
+        self.name
+            .as_ref()
+            .expect("walls are named by `name_the_only_wall` before they are read")
+    }
 }
 
 /// A rigid body (`[[body]]`): the bodies layer derives T, V and the

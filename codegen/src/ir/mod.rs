@@ -357,6 +357,7 @@ pub fn parse(path: &Path, text: &str) -> Result<Model, ModelErrors> {
             return Err(cx.into_errors());
         }
     };
+    name_the_only_wall(&mut file, &mut cx);
     let from_bodies = bodies::expand(&mut file, &mut cx);
     let model = Validator {
         cx: &mut cx,
@@ -376,6 +377,34 @@ pub fn parse(path: &Path, text: &str) -> Result<Model, ModelErrors> {
         Some(m) => cx.finish(m),
         None => Err(cx.into_errors()),
     }
+}
+
+/// The name a model's only wall has when its file gives none.
+const ONLY_WALL: &str = "wall";
+
+/// A wall without `name` is [`ONLY_WALL`] when it is the model's only
+/// one; among several, each unnamed wall is an error at its declaration
+/// (and is left out, so that what follows reads named walls only).
+fn name_the_only_wall(file: &mut File, cx: &mut Collector) {
+    let count = file.wall.len();
+    file.wall.retain_mut(|decl| {
+        let span = decl.span();
+        let w = decl.get_mut();
+        if w.name.is_some() {
+            return true;
+        }
+        if count == 1 {
+            w.name = Some(toml::Spanned::new(span, ONLY_WALL.to_string()));
+            return true;
+        }
+        cx.error(
+            ErrorKind::Structure(format!(
+                "the model has {count} walls: give each a `name` (only a model's only wall may leave it out: it is then `{ONLY_WALL}`)"
+            )),
+            Some(span),
+        );
+        false
+    });
 }
 
 /// Reports every name used in the model's expressions that is not declared.

@@ -160,7 +160,7 @@ pub(super) fn expand(file: &mut File, cx: &mut Collector) -> Vec<FromBodies> {
         .map(|w| w.get_ref())
         .filter(|w| w.body.is_some())
     {
-        let name = w.name.get_ref();
+        let name = w.name().get_ref();
         record.extend(
             w.surface
                 .iter()
