@@ -146,39 +146,55 @@ fn a_narrow_bump_under_a_long_flight() {
     check("over the bump", &m, over, 40.0, None);
 }
 
+/// The bump with g = 9.81, and its half-width.
+fn bump_under_gravity() -> (Interpreted<2>, f64) {
+    let mut m = model::<2>("floor_bump");
+    assert!(m.set_parameter_named("g", 9.81));
+    let w = m.parameter_named("w").unwrap();
+    (m, w)
+}
+
+/// The first root before `until` of the bump's f along the exact parabola
+/// (g = 9.81) from (x0, y0) at (vx, vy): on a grid of 10⁻⁶ s, refined by
+/// bisection.
+fn first_root(w: f64, (x0, y0): (f64, f64), (vx, vy): (f64, f64), until: f64) -> Option<f64> {
+    let f = |t: f64| {
+        let (x, y) = (x0 + vx * t, y0 + vy * t - 9.81 * t * t / 2.0);
+        y + 0.5 - (-(x / w) * (x / w)).exp()
+    };
+    let grid = 1e-6;
+    let mut t = grid;
+    while t < until && f(t) > 0.0 {
+        t += grid;
+    }
+    if t >= until {
+        return None;
+    }
+    let (mut a, mut b) = (t - grid, t);
+    for _ in 0..60 {
+        let c = 0.5 * (a + b);
+        if f(c) > 0.0 { a = c } else { b = c }
+    }
+    Some(b)
+}
+
 /// The same bump under parabolic flights (g = 9.81) launched from the
 /// floor's height towards it: the reference is the first root of f along
 /// the exact parabola, found on a grid of 10⁻⁶ s and refined by bisection.
 #[test]
 fn a_narrow_bump_under_a_parabola() {
-    let mut m = model::<2>("floor_bump");
-    assert!(m.set_parameter_named("g", 9.81));
-    let w = m.parameter_named("w").unwrap();
+    let (m, w) = bump_under_gravity();
     let mut seed = 11;
     let mut met = 0;
     for _ in 0..8 {
         let mut u = || lcg(&mut seed);
         let (x0, vx, vy) = (-0.5 - 2.0 * u(), 1.0 + 2.0 * u(), 2.0 + 2.0 * u());
         let y0 = -0.4;
-        let f = |t: f64| {
-            let (x, y) = (x0 + vx * t, y0 + vy * t - 9.81 * t * t / 2.0);
-            y + 0.5 - (-(x / w) * (x / w)).exp()
-        };
         // The flight lands on the floor y = −1/2 (away from the bump) at
         // `landing`; the first root of f, the bump's or the floor's, is the
         // reference.
         let landing = (vy + (vy * vy + 2.0 * 9.81 * (y0 + 0.5)).sqrt()) / 9.81;
-        let grid = 1e-6;
-        let mut t = grid;
-        while f(t) > 0.0 {
-            t += grid;
-        }
-        let (mut a, mut b) = (t - grid, t);
-        for _ in 0..60 {
-            let c = 0.5 * (a + b);
-            if f(c) > 0.0 { a = c } else { b = c }
-        }
-        let reference = b;
+        let reference = first_root(w, (x0, y0), (vx, vy), landing + 1.0).unwrap();
         if reference < landing - 1e-3 {
             met += 1;
         }
@@ -197,6 +213,53 @@ fn a_narrow_bump_under_a_parabola() {
     }
     // Some of the flights meet the bump before the floor.
     assert!(met >= 2, "{met} of 8 flights meet the bump");
+}
+
+/// Flights from the floor to the floor (g = 9.81) that pass the bump in
+/// their middle half: a step with both ends on the wall, whose stretch is
+/// split into a quarter at each end and the half between
+/// (`enclosure.rs`). Launched from y = −1/2 at x0 so that the bump is
+/// reached at a fraction 0.3 to 0.7 of the flight, some low enough to hit
+/// it, some flying over it: the reference is the first root of f along the
+/// exact parabola (a grid of 10⁻⁶ s refined by bisection), the bump's or
+/// the landing's.
+#[test]
+fn a_narrow_bump_in_the_middle_of_a_bounce() {
+    let (m, w) = bump_under_gravity();
+    let mut seed = 5;
+    let (mut hit, mut over) = (0, 0);
+    for _ in 0..10 {
+        let mut u = || lcg(&mut seed);
+        let (vx, vy, fraction) = (0.5 + 1.5 * u(), 3.5 + 3.0 * u(), 0.3 + 0.4 * u());
+        let landing = 2.0 * vy / 9.81;
+        let x0 = -vx * fraction * landing;
+        let reference = match first_root(w, (x0, -0.5), (vx, vy), landing) {
+            Some(t) => {
+                hit += 1;
+                t
+            }
+            None => {
+                over += 1;
+                landing
+            }
+        };
+        let start = State {
+            t: 0.0,
+            q: [x0, -0.5],
+            v: [vx, vy],
+        };
+        check(
+            "bump in a bounce",
+            &m,
+            start,
+            landing + 0.1,
+            Some(reference),
+        );
+    }
+    assert!(
+        hit >= 2 && over >= 2,
+        "{hit} flights hit the bump, {over} fly over it"
+    );
 }
 
 /// The sleigh turns on the unit circle at unit speed (its blade at the

@@ -6,8 +6,9 @@
 //! f over that box in the model's `surface_bounds`. A box on which f > 0
 //! is clear, and so is one on which f is proven monotone
 //! (`normal_bounds` · dq/dθ of one sign) and positive at the end it
-//! falls towards. Other boxes are halved, and a midpoint with f ≤ 0 is a
-//! crossing earlier than the one the samples found.
+//! falls towards. Other boxes are split (a quarter at each end, the half
+//! between), and a split point with f ≤ 0 is a crossing earlier than the
+//! one the samples found.
 //!
 //! What is not proven is left to the samples, as before: a stretch
 //! narrower than 2^−[`CLEAR_DEPTH`] of the step on which neither test
@@ -131,7 +132,7 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             b: ends.end,
             fb: ends.f_end,
             depth: 0,
-        }; CLEAR_DEPTH + 2];
+        }; 2 * CLEAR_DEPTH + 3];
         let mut top = 1;
         let mut boxes = 0;
         // Only the coordinates f depends on are bounded: those whose entry
@@ -179,41 +180,63 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
             if s.depth >= CLEAR_DEPTH {
                 continue;
             }
-            let mid = 0.5 * (s.a + s.b);
-            let fm = f(mid);
-            let depth = s.depth + 1;
-            if fm <= 0.0 && s.fa > 0.0 {
-                // A crossing before `end`: what lies beyond `mid` (the
-                // rest of the stack) no longer matters.
-                end = mid;
-                found = Some(Bracket {
-                    a: s.a,
-                    fa: s.fa,
-                    b: mid,
-                    fb: fm,
-                });
-                stack[0] = Stretch {
-                    b: mid,
-                    fb: fm,
-                    depth,
+            // A stretch with both ends on the wall (a step from one
+            // collision to the next) has its hump in the middle: split it
+            // into a quarter at each end, monotone, and the half between,
+            // clear by f > 0. Others are halved.
+            let starts_on_wall = s.fa <= 0.0 || (s.a == 0.0 && ends.leaving);
+            let width = s.b - s.a;
+            let (points, depths): (&[f64], &[usize]) = if starts_on_wall && s.fb <= 0.0 {
+                (&[0.25, 0.75], &[2, 1, 2])
+            } else {
+                (&[0.5], &[1, 1])
+            };
+            // The children, left to right; at most three.
+            let mut children = [s; 3];
+            let (mut count, mut crossed) = (0, false);
+            let mut from = (s.a, s.fa);
+            for (i, &p) in points.iter().enumerate() {
+                let x = s.a + p * width;
+                let fx = f(x);
+                children[i] = Stretch {
+                    a: from.0,
+                    fa: from.1,
+                    b: x,
+                    fb: fx,
+                    depth: s.depth + depths[i],
+                };
+                count = i + 1;
+                if fx <= 0.0 && from.1 > 0.0 {
+                    // A crossing before `end` in this child: what lies
+                    // beyond it (the rest of the stack, the children to
+                    // its right) no longer matters.
+                    end = x;
+                    found = Some(Bracket {
+                        a: from.0,
+                        fa: from.1,
+                        b: x,
+                        fb: fx,
+                    });
+                    (top, crossed) = (0, true);
+                    break;
+                }
+                from = (x, fx);
+            }
+            if !crossed {
+                // No crossing at a split point: the last child too.
+                children[count] = Stretch {
+                    a: from.0,
+                    fa: from.1,
+                    depth: s.depth + depths[count],
                     ..s
                 };
-                top = 1;
-                continue;
+                count += 1;
             }
-            stack[top] = Stretch {
-                a: mid,
-                fa: fm,
-                depth,
-                ..s
-            };
-            stack[top + 1] = Stretch {
-                b: mid,
-                fb: fm,
-                depth,
-                ..s
-            };
-            top += 2;
+            // The leftmost on top: the first crossing is searched first.
+            for child in children[..count].iter().rev() {
+                stack[top] = *child;
+                top += 1;
+            }
         }
         found.filter(|_| end < ends.end)
     }

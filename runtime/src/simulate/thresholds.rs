@@ -103,9 +103,9 @@ pub const ON_WALL_ULPS: f64 = 4.0;
 /// Newton (or bisection) steps at most on the step's polynomial.
 pub const SERIES_ROOT_ITERATIONS: usize = 100;
 
-/// Halvings at most of a stretch of a step that the bounds on a wall's f
-/// do not prove clear (`enclosure`): narrower stretches are left to the
-/// samples.
+/// How narrow, in halvings of a step, a stretch of it may get that the
+/// bounds on a wall's f do not prove clear (`enclosure`): narrower ones
+/// are left to the samples.
 pub const CLEAR_DEPTH: usize = 16;
 
 /// Boxes at most on which one wall is bounded along one step; past them
