@@ -189,13 +189,15 @@ pub enum PeriodicError<W> {
         residual: f64,
     },
     /// Newton's method stopped (as [`PeriodicError::NoConvergence`] or
-    /// [`PeriodicError::Stalled`] would say) while heading for a state
-    /// that does not leave the wall: the normal velocity of the state
-    /// reached is below [`GRAZING`] of the velocity's size (often its full
-    /// steps land where the normal velocity is not positive, so they are
-    /// taken in part; or the return map loses its accuracy as the impacts
-    /// fade). The states it approaches move along the wall, or rest
-    /// against it, not through collisions with it; more steps do not help.
+    /// [`PeriodicError::Stalled`] would say), or met its tolerance, at a
+    /// state that barely leaves the wall: its normal velocity is below
+    /// [`GRAZING`] of the velocity's size (often its full steps land where
+    /// the normal velocity is not positive, so they are taken in part; or
+    /// the return map loses its accuracy as the impacts fade; or the
+    /// flight between collisions is so short that the state changes less
+    /// than the tolerance over it). The states it approaches move along
+    /// the wall, or rest against it, not through collisions with it; more
+    /// steps do not help.
     TowardsGrazing {
         /// Steps taken.
         iterations: usize,
@@ -311,6 +313,13 @@ pub fn find<M: TaylorSeries<N>, const N: usize>(
         let residual = residual_of(&x, &map);
         let merit = merit_of(&x, &map);
         let jacobian = map.jacobian.expect("asked for");
+        if residual <= search.tolerance && nearly_grazes(model, &x, section.wall) {
+            // Converged to a state that barely leaves the wall: its flight
+            // to the next collision, and with it every change over a
+            // return, shrinks with its normal velocity, so any such state
+            // meets the tolerance. It slides along the wall; no orbit.
+            return Err(stopped(&x, iterations, residual, false));
+        }
         if residual <= search.tolerance {
             let z = section_basis(model, &x, section.wall)?;
             let multipliers = multipliers(&z, &jacobian)?;
