@@ -146,6 +146,30 @@ fn coin_start<M: Dynamics<5>>(m: &M, q: [f64; 5], rates: [f64; 3]) -> State<5> {
     State { t: 0.0, q, v }
 }
 
+/// The coin lying flat (θ = 0), where its z-x-z angles φ and ψ both turn
+/// it about its axis: G is singular there, and the start is refused as
+/// such, not left to shrink Dormand–Prince's steps to nothing (its q̈ in
+/// closed form divides by sin θ).
+#[test]
+fn a_coin_lying_flat_is_a_singular_start() {
+    use dalembert::runtime::dynamics::DynamicsError;
+    use dalembert::runtime::simulate::SimError;
+    let m = Interpreted::<5>::new(&derived("tests/bodies", "coin")).unwrap();
+    let flat = State {
+        t: 0.0,
+        q: [0.0, 0.0, 0.3, 0.0, 0.0],
+        v: [0.0; 5],
+    };
+    let e = Simulator::new(&m, flat, Settings::default()).err();
+    assert_eq!(
+        e,
+        Some(SimError::Dynamics {
+            t: 0.0,
+            error: DynamicsError::SingularMassMatrix
+        })
+    );
+}
+
 /// The coin between two smooth walls (tests/bodies/coin_walls.toml, the
 /// walls' surfaces derived from the disk: f = n·S − offset − R√(1 − (n·e)²)).
 /// Upright and rolling head-on into the wall x = 0 at speed R w from

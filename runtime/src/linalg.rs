@@ -51,6 +51,10 @@ pub struct Cholesky<const N: usize> {
     n: usize,
 }
 
+/// A Cholesky pivot at most this many units of roundoff of its diagonal
+/// entry counts as zero ([`Cholesky::new`]).
+pub const PIVOT_ULPS: f64 = 16.0;
+
 impl<const N: usize> Cholesky<N> {
     /// Factors the leading `n`×`n` block of `a` (the rest is ignored);
     /// `None` unless that block is (numerically) positive definite.
@@ -62,8 +66,13 @@ impl<const N: usize> Cholesky<N> {
             for j in 0..=i {
                 let sum = a[i][j] - dot_prefix(&l[i], &l[j], j);
                 if i == j {
-                    // NaN fails the comparison too.
-                    if sum.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
+                    // A pivot within rounding of zero, relative to the
+                    // entry it came from, has lost every digit to
+                    // cancellation: the block is singular to working
+                    // precision (a coin lying flat in z-x-z angles, whose
+                    // φ and ψ turn it about one axis). NaN fails too.
+                    let floor = PIVOT_ULPS * f64::EPSILON * libm::fabs(a[i][i]);
+                    if sum.partial_cmp(&floor) != Some(core::cmp::Ordering::Greater) {
                         return None;
                     }
                     l[i][i] = libm::sqrt(sum);

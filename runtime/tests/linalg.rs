@@ -50,6 +50,16 @@ fn cholesky_solves_and_rejects() {
     let indefinite = [[1.0, 2.0], [2.0, 1.0]];
     assert!(Cholesky::new(&indefinite, 2).is_none());
     assert!(Cholesky::new(&[[f64::NAN, 0.0], [0.0, 1.0]], 2).is_none());
+    // Singular blocks whose last pivot comes out of the rounding a few ulps
+    // above zero (0.125 − (0.125/√0.125)² = 2.8e-17, 0.7's 1.1e-16): the
+    // coin lying flat, whose φ and ψ both turn it about its axis
+    // (moment 1/8), has this block. Singular to working precision.
+    for c in [0.125, 0.7, 0.3] {
+        assert!(Cholesky::new(&[[c, c], [c, c]], 2).is_none(), "{c}");
+    }
+    // Nearly singular but not to working precision: factored.
+    let near = 1.0 - 1e-10;
+    assert!(Cholesky::new(&[[1.0, near], [near, 1.0]], 2).is_some());
 }
 
 /// The generic projector agrees with the constrained solve: P v equals the
