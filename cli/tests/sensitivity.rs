@@ -435,6 +435,21 @@ fn by_names_only_parameters_of_the_model() {
         ),
         "{stderr}"
     );
+    // A model without parameters says it has none.
+    let file = PathBuf::from(&dir).join("no_parameters.toml");
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = "[coordinates]\nnames = [\"x\"]\n[dynamics]\nkinetic_energy = \"x_dot^2/2\"\npotential = \"x\"\n[[wall]]\nsurface = \"x\"\n[initial]\nx = 1\n";
+    std::fs::write(&file, text).unwrap();
+    let file = file.to_str().unwrap();
+    let args = [
+        "simulate", file, "--t-end", "0.1", "--by", "g", "--out", &dir,
+    ];
+    let (ok, stdout, stderr) = dalembert(&args);
+    assert!(!ok, "{stdout}");
+    assert!(
+        stderr.contains("--by: `g` is not a parameter of no_parameters (parameters: it has none)"),
+        "{stderr}"
+    );
 }
 
 /// `--by l` on the built-in pendulum, whose rod length l moves its

@@ -165,7 +165,11 @@ pub(super) fn by_parameters<M: Surfaces<N>, const N: usize>(
     for name in spec.split(',').map(str::trim) {
         let Some(k) = all.iter().position(|p| p == name) else {
             let model_name = model.name();
-            let list = all.join(", ");
+            let list = if all.is_empty() {
+                "it has none".to_string()
+            } else {
+                all.join(", ")
+            };
             return Err(if derived.iter().any(|d| d == name) {
                 format!(
                     "--by: `{name}` is a derived parameter of {model_name} (computed from others): differentiate by those it is computed from (parameters: {list})"
