@@ -313,14 +313,15 @@ pub fn find<M: TaylorSeries<N>, const N: usize>(
         let residual = residual_of(&x, &map);
         let merit = merit_of(&x, &map);
         let jacobian = map.jacobian.expect("asked for");
-        if residual <= search.tolerance && nearly_grazes(model, &x, section.wall) {
-            // Converged to a state that barely leaves the wall: its flight
-            // to the next collision, and with it every change over a
-            // return, shrinks with its normal velocity, so any such state
-            // meets the tolerance. It slides along the wall; no orbit.
-            return Err(stopped(&x, iterations, residual, false));
-        }
         if residual <= search.tolerance {
+            if nearly_grazes(model, &x, section.wall) {
+                // Converged to a state that barely leaves the wall: its
+                // flight to the next collision, and with it every change
+                // over a return, shrinks with its normal velocity, so any
+                // such state meets the tolerance. It slides along the
+                // wall; no orbit.
+                return Err(stopped(&x, iterations, residual, false));
+            }
             let z = section_basis(model, &x, section.wall)?;
             let multipliers = multipliers(&z, &jacobian)?;
             return Ok(Orbit {

@@ -483,15 +483,16 @@ impl Validator<'_> {
         let mut variants: HashMap<String, String> = HashMap::new();
         for decl in decls {
             let w = decl.get_ref();
+            let at = w.name().span();
             let name = w.name().get_ref().clone();
-            self.check_ident(&name, w.name().span(), false);
+            self.check_ident(&name, at.clone(), false);
             if name.chars().any(|c| c.is_ascii_uppercase()) {
                 self.cx.error(
                     ErrorKind::BadName {
                         name: name.clone(),
                         why: "a wall's name is snake_case (lower case, digits and `_`)".into(),
                     },
-                    Some(w.name().span()),
+                    Some(at.clone()),
                 );
             } else if let Some(first) = variants.insert(camel(&name), name.clone()) {
                 let kind = if first == name {
@@ -508,7 +509,7 @@ impl Validator<'_> {
                         ),
                     }
                 };
-                self.cx.error(kind, Some(w.name().span()));
+                self.cx.error(kind, Some(at.clone()));
             }
             match (kind, &w.surface, &w.normal_velocity) {
                 // A wall met by a body (named, or the only one) or given
