@@ -149,6 +149,32 @@ fn same_functions<M: TaylorSeries<N>, I: TaylorSeries<N>, const N: usize>(
             agree(&format!("{name} series q{k}"), &tc.q[k], &ti.q[k]);
             agree(&format!("{name} series v{k}"), &tc.v[k], &ti.v[k]);
         }
+        // The variational series along them, from N columns of δq then
+        // N of δv (both or neither).
+        for half in 0..2 {
+            let column = |j: usize| {
+                let (mut dq, mut dv) = ([0.5; N], [-0.25; N]);
+                [&mut dq, &mut dv][half][j] = 1.0;
+                Series::at(&dq, &dv)
+            };
+            let mut cc: [Series<N>; N] = std::array::from_fn(column);
+            let mut ci = cc;
+            let offered = c.variational_series(&tc, &mut cc);
+            assert_eq!(
+                offered,
+                i.variational_series(&tc, &mut ci),
+                "{name}: variational series offered alike"
+            );
+            for (j, (a, b)) in cc.iter().zip(&ci).enumerate().filter(|_| offered) {
+                assert_eq!((a.order, b.order), (tc.order, tc.order), "{name}");
+                let to = ..=tc.order;
+                for k in 0..N {
+                    let what = format!("{name} column {j} of the δq{k} block {half}");
+                    agree(&what, &a.q[k][to], &b.q[k][to]);
+                    agree(&what, &a.v[k][to], &b.v[k][to]);
+                }
+            }
+        }
     }
     assert_eq!(c.walls().len(), i.walls().len());
     for (&wc, &wi) in c.walls().iter().zip(i.walls()) {

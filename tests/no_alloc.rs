@@ -221,7 +221,10 @@ fn interpreted_series_do_not_allocate() {
         for &w in ball.walls() {
             assert!(ball.surface_series(w, &s, &mut (), &mut f));
         }
-        f[2]
+        // And the variational series along it (Φ is followed below).
+        let mut columns = [Series::at(&start.v, &start.q); 1];
+        assert!(ball.variational_series(&s, &mut columns));
+        f[2] + columns[0].q[0][3]
     };
     let first = series();
     let mut again = 0.0;

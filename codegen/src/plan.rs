@@ -7,7 +7,8 @@
 //! - **machine form**: every instruction in the place it runs, as a
 //!   [`Machine`] (negations, powers, roots, sin/cos pairs decided there);
 //! - **Taylor transforms**: the series of q̈ (the cheapest of the closed
-//!   form and each elimination's) and of each wall's f.
+//!   form and each elimination's), of each wall's f, and of the
+//!   variational equation along the motion (q̈'s tangent).
 //!
 //! [`crate::emit`] writes a plan as Rust. [`crate::interpret`] runs each
 //! program whole per call (the same values: hoisting only moves work) and
@@ -30,6 +31,10 @@ pub struct Plan<'a> {
     /// The Taylor transforms of q̈ and of each wall's f, where q̈ is written
     /// out and series were asked for.
     pub series: Option<(Transform, Vec<Transform>)>,
+    /// Where there are series and a tangent of q̈: the Taylor transform of
+    /// the variational equation, a second-order system over (q, δq)
+    /// ([`Program::variational`]) whose outputs are δq̈.
+    pub variational: Option<Transform>,
 }
 
 /// One function, placed.
@@ -103,11 +108,14 @@ impl<'a> Plan<'a> {
                 }
             })
             .collect();
+        let series = (taylor == Taylor::Include).then(|| transforms(d)).flatten();
+        let variational = (series.as_ref()).and_then(|(motion, _)| variational(d, motion));
         Self {
             derivation: d,
             functions,
             stored,
-            series: (taylor == Taylor::Include).then(|| transforms(d)).flatten(),
+            series,
+            variational,
         }
     }
 
@@ -185,6 +193,32 @@ fn transforms(d: &Derivation) -> Option<(Transform, Vec<Transform>)> {
         })
         .collect::<Option<Vec<_>>>()?;
     Some((motion, walls))
+}
+
+/// How many times the motion's series the variational system's may cost
+/// (in multiply-adds at the default tolerance's order, all of its ops
+/// counted). A tangent costs about three times its program: 2.5 to 3.2
+/// times the motion's series for the built-in models and the test files
+/// whose series is q̈'s own, 4.1 with every arc and hyperbolic function in
+/// q̈ (`tests/walls/disk_functions.toml`). Where the motion's series is
+/// solved per order from G (the chains), the tangent of the written-out q̈
+/// costs 6.4 to 21 times it, and Φ is left to its integration along the
+/// step instead.
+const VARIATIONAL_COST: usize = 5;
+
+/// The Taylor transform of the variational system along the motion
+/// ([`Program::variational`] of q̈'s tangent), where q̈ has a tangent and
+/// its series costs at most [`VARIATIONAL_COST`] times `motion`'s.
+fn variational(d: &Derivation, motion: &Transform) -> Option<Transform> {
+    let (np, n) = (d.model.params.len(), d.model.velocities.len());
+    let tangent = d.function(Quantity::AccelerationsTangent)?;
+    let t = tangent
+        .program
+        .variational(np, n)
+        .taylor(np, 2 * n)
+        .shared(n);
+    let order = dalembert_runtime::simulate::Taylor::default().order();
+    (t.cost(order) <= VARIATIONAL_COST * motion.cost(order)).then_some(t)
 }
 
 #[cfg(test)]

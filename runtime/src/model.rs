@@ -400,6 +400,20 @@ pub trait TaylorSeries<const N: usize>: Surfaces<N> {
         false
     }
 
+    /// Columns of the variational flow along the motion's `series` (filled
+    /// by [`TaylorSeries::taylor_series`]): each of `columns` holds a
+    /// tangent (δq, δq̇) at order 0 and gets its coefficients of orders 1
+    /// to `series.order` and that order, the series of the variational
+    /// equation δq̈ = ∂q̈/∂q δq + ∂q̈/∂q̇ δq̇ along the motion (the
+    /// derivative of the motion's polynomial along its start).
+    /// [`crate::simulate::Variational`] carries Φ over a step of Taylor's
+    /// method with it. `false` (the default) means the model has none and
+    /// the columns are untouched.
+    fn variational_series(&self, series: &Series<N>, columns: &mut [Series<N>]) -> bool {
+        let _ = (series, columns);
+        false
+    }
+
     /// The work per order of [`TaylorSeries::taylor_series`] and of the
     /// walls' [`TaylorSeries::surface_series`], from which Taylor's method
     /// picks the order that costs least per unit of time. `None` (the

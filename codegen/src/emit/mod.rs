@@ -158,6 +158,15 @@ fn header(d: &Ctx) -> String {
                 "//   {name:<28} {ops} ops, {loops} convolutions\n"
             ));
         }
+        if let Some(t) = &d.plan.variational {
+            let work = t.work();
+            let (ops, loops) = (work.operations, work.convolutions);
+            let shared = t.shared.unwrap_or(0);
+            h.push_str(&format!(
+                "//   {:<28} {ops} ops, {loops} convolutions (the first {shared} ops once for all columns)\n",
+                "tangent_series"
+            ));
+        }
     }
     let once = counts
         .iter()

@@ -87,6 +87,19 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
             };
             let motion_work = work(motion.work());
             let walls_work = work(walls.iter().map(Transform::work).sum());
+            let variational = d.plan.variational.as_ref().map(|_| {
+                quote! {
+                    #[inline]
+                    fn variational_series(
+                        &self,
+                        series: &::dalembert_runtime::taylor::Series<#nl>,
+                        columns: &mut [::dalembert_runtime::taylor::Series<#nl>],
+                    ) -> bool {
+                        self.tangent_series(series, columns);
+                        true
+                    }
+                }
+            });
             let arms = d.derivation.walls.iter().zip(&variants).map(|(w, v)| {
                 let f = format_ident!("{}_surface_series", w.name);
                 quote! { Wall::#v => self.#f(series, scratch, out) }
@@ -117,6 +130,7 @@ pub(super) fn trait_impl(d: &Ctx) -> TokenStream {
                         match wall { #(#arms,)* }
                         true
                     }
+                    #variational
                     #[inline]
                     fn series_work(&self) -> Option<::dalembert_runtime::taylor::SeriesWork> {
                         Some(::dalembert_runtime::taylor::SeriesWork {

@@ -98,27 +98,34 @@ pub struct Interpreted<const N: usize> {
 struct SeriesPrograms {
     motion: (Transform, Vec<f64>),
     walls: Vec<(Transform, Vec<f64>)>,
+    /// The variational system's (`tangent_series`), where q̈ has a tangent.
+    variational: Option<(Transform, Vec<f64>)>,
     /// The coefficients of one evaluation, reused by every call (a step
     /// of Taylor's method allocates nothing once it has run).
     workspace: RefCell<Evaluation>,
 }
 
 impl SeriesPrograms {
-    fn new((motion, walls): (Transform, Vec<Transform>), params: &[f64]) -> Self {
+    fn new(plan: Plan, params: &[f64]) -> Option<Self> {
+        let (motion, walls) = plan.series?;
         let with_numbers = |t: Transform| {
             let numbers = t.number_values(params, run_program);
             (t, numbers)
         };
-        Self {
+        Some(Self {
             motion: with_numbers(motion),
             walls: walls.into_iter().map(with_numbers).collect(),
+            variational: plan.variational.map(with_numbers),
             workspace: RefCell::default(),
-        }
+        })
     }
 
     /// Recomputes the time-constant values (the parameters changed).
     fn refresh(&mut self, params: &[f64]) {
-        for (t, numbers) in std::iter::once(&mut self.motion).chain(&mut self.walls) {
+        let all = std::iter::once(&mut self.motion)
+            .chain(&mut self.walls)
+            .chain(&mut self.variational);
+        for (t, numbers) in all {
             *numbers = t.number_values(params, run_program);
         }
     }
@@ -215,8 +222,7 @@ impl<const N: usize> Interpreted<N> {
                 surface_parameter_tangent: find(&w.functions, Quantity::SurfaceParameterTangent),
             });
         }
-        let series =
-            (Plan::new(d, Taylor::Include).series).map(|t| SeriesPrograms::new(t, &values));
+        let series = SeriesPrograms::new(Plan::new(d, Taylor::Include), &values);
         Ok(Self {
             series,
             name: leak_names(std::iter::once(m.name.clone()))[0],
@@ -587,6 +593,31 @@ impl<const N: usize> TaylorSeries<N> for Interpreted<N> {
         e.v.clear();
         e.v.extend_from_slice(&series.v);
         *out = t.along(numbers, e, series.order);
+        true
+    }
+    fn variational_series(&self, series: &Series<N>, columns: &mut [Series<N>]) -> bool {
+        let Some(sp) = &self.series else {
+            return false;
+        };
+        let Some((t, numbers)) = &sp.variational else {
+            return false;
+        };
+        let order = series.order.min(MAX_ORDER);
+        let e = &mut *sp.workspace.borrow_mut();
+        for (e, x) in [(&mut e.q, &series.q), (&mut e.v, &series.v)] {
+            e.clear();
+            e.extend_from_slice(x);
+            e.extend_from_slice(x);
+        }
+        t.shared_into(e, numbers, order);
+        for c in columns {
+            e.q[N..].copy_from_slice(&c.q);
+            e.v[N..].copy_from_slice(&c.v);
+            t.tangent_into(e, numbers, order);
+            c.q.copy_from_slice(&e.q[N..]);
+            c.v.copy_from_slice(&e.v[N..]);
+            c.order = order;
+        }
         true
     }
     fn series_work(&self) -> Option<SeriesWork> {

@@ -9,7 +9,7 @@
 //! most a few for its tangent, and a value that does not depend on the
 //! differentiated inputs has none (its tangent is known to be zero).
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use super::{Func, Instr, Program, Slot, constant};
 use crate::ir::Function;
@@ -90,6 +90,62 @@ impl Program {
             ..self.clone()
         }
     }
+}
+
+impl Program {
+    /// The variational system of a tangent of q̈ (this program: inputs
+    /// `params` parameters, then q, v, δq, δv, each `n` long; outputs q̈ then
+    /// δq̈) as a second-order system of dimension 2n: inputs the parameters,
+    /// then (q, δq) as its coordinates and (v, δv) as its velocities;
+    /// outputs δq̈ alone, with the work only q̈ needed left out. Its Taylor
+    /// transform ([`Program::taylor`] with `2n` coordinates) is the series
+    /// of a column of the variational flow along the motion's.
+    pub fn variational(&self, params: usize, n: usize) -> Program {
+        assert!(
+            self.inputs == params + 4 * n && self.outputs == 2 * n,
+            "a tangent of q̈ over (q, v) of length {n}"
+        );
+        // Inputs (q, v, δq, δv) → (q, δq, v, δv): v and δq trade places.
+        let input = |i: usize| match i.checked_sub(params) {
+            Some(k) if (n..2 * n).contains(&k) => params + k + n,
+            Some(k) if (2 * n..3 * n).contains(&k) => params + k - n,
+            _ => i,
+        };
+        let slot = |s: Slot| match s {
+            Slot::Input(i) => Slot::Input(input(i)),
+            Slot::Out(k) if k >= n => Slot::Out(k - n),
+            // q̈'s outputs: written by the instructions left out below.
+            other => other,
+        };
+        let writes_q_dd = |ins: &Instr| matches!(ins.dst(), Slot::Out(k) if k < n);
+        let kept: Vec<Instr> = (self.instrs.iter())
+            .filter(|ins| !writes_q_dd(ins))
+            .map(|ins| ins.map_slots(slot))
+            .collect();
+        Program {
+            inputs: self.inputs,
+            consts: self.consts.clone(),
+            instrs: live(kept),
+            outputs: n,
+        }
+    }
+}
+
+/// The instructions whose values reach an output, in order (a slot written
+/// again is live from its last write before a read).
+fn live(instrs: Vec<Instr>) -> Vec<Instr> {
+    let mut needed: HashSet<Slot> = HashSet::new();
+    let mut keep = vec![false; instrs.len()];
+    for (i, ins) in instrs.iter().enumerate().rev() {
+        let dst = ins.dst();
+        if matches!(dst, Slot::Out(_)) || needed.remove(&dst) {
+            keep[i] = true;
+            needed.extend(ins.sources().iter().copied());
+        }
+    }
+    (instrs.into_iter().zip(keep))
+        .filter_map(|(ins, k)| k.then_some(ins))
+        .collect()
 }
 
 /// The tangent program as it is built.
@@ -400,5 +456,41 @@ mod tests {
             assert_eq!(out[6], 2.0 * point[0], "d(p²)/dp");
             assert_eq!(out[7], 0.0, "1.5 − x does not move with p");
         }
+    }
+
+    /// The variational system of q̈ = (p sin(x) ẏ, x + ẋ) over (x, y): its
+    /// inputs reordered to (p, x, y, δx, δy, ẋ, ẏ, δẋ, δẏ), its outputs
+    /// the tangent's δq̈, and the sum x + ẋ, which only q̈ reads, left out.
+    #[test]
+    fn variational_system_of_a_tangent() {
+        let (p, x, vx, vy) = (
+            Slot::Input(0),
+            Slot::Input(1),
+            Slot::Input(3),
+            Slot::Input(4),
+        );
+        let q_dd = Program {
+            inputs: 5,
+            consts: vec![],
+            instrs: vec![
+                Instr::Fun(Slot::Temp(0), Func::Sin, x),
+                Instr::Mul(Slot::Out(0), vec![p, Slot::Temp(0), vy]),
+                Instr::Add(Slot::Out(1), vec![x, vx]),
+            ],
+            outputs: 2,
+        };
+        let t = q_dd.tangent(1);
+        let v = t.variational(1, 2);
+        assert_eq!((v.inputs, v.outputs), (9, 2));
+        let sums = |p: &Program| {
+            (p.instrs.iter())
+                .filter(|i| matches!(i, Instr::Add(_, s) if s.contains(&x)))
+                .count()
+        };
+        assert_eq!((sums(&t), sums(&v)), (1, 0), "x + ẋ is not needed");
+        let (pq, pv, dq, dv) = ([0.4, -1.3], [0.8, 2.1], [0.3, -0.5], [1.7, 0.2]);
+        let tangent_inputs: Vec<f64> = [&[1.5][..], &pq, &pv, &dq, &dv].concat();
+        let inputs: Vec<f64> = [&[1.5][..], &pq, &dq, &pv, &dv].concat();
+        assert_eq!(v.eval(&inputs), t.eval(&tangent_inputs)[2..]);
     }
 }

@@ -50,6 +50,9 @@ pub(super) trait Room<const N: usize> {
     fn surface(&mut self, k: usize, out: &mut Coefficients) -> bool;
     /// [`TaylorSeries::series_work`].
     fn work(&self) -> Option<SeriesWork>;
+    /// [`TaylorSeries::variational_series`] along the series, extended to
+    /// `order` first where that is higher than its own.
+    fn variational(&self, columns: &mut [Series<N>], order: usize) -> bool;
 }
 
 impl<M: TaylorSeries<N>, const N: usize> Room<N> for SeriesRoom<'_, M, N> {
@@ -72,5 +75,24 @@ impl<M: TaylorSeries<N>, const N: usize> Room<N> for SeriesRoom<'_, M, N> {
 
     fn work(&self) -> Option<SeriesWork> {
         self.model.series_work()
+    }
+
+    fn variational(&self, columns: &mut [Series<N>], order: usize) -> bool {
+        if order <= self.series.order {
+            return self.model.variational_series(&self.series, columns);
+        }
+        // The same series to a higher order: its coefficients up to its
+        // own order are the same (each order's recurrence reads lower
+        // ones only), computed in room of its own (the scratch is the
+        // simulator's, and this reads the room).
+        let mut longer = self.series;
+        let (q, v) = (
+            core::array::from_fn(|i| longer.q[i][0]),
+            core::array::from_fn(|i| longer.v[i][0]),
+        );
+        longer.restart(&q, &v);
+        let scratch = &mut M::SeriesScratch::default();
+        self.model.taylor_series(&mut longer, scratch, order)
+            && self.model.variational_series(&longer, columns)
     }
 }

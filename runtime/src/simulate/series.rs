@@ -102,6 +102,16 @@ impl<M: Surfaces<N>, const N: usize> Simulator<'_, M, N> {
         self.room.as_deref().map(|r| r.series())
     }
 
+    /// Columns of the variational flow along the last step's series,
+    /// extended to `order` where that is higher than its own
+    /// ([`TaylorSeries::variational_series`](crate::TaylorSeries::variational_series));
+    /// `false` where there is no room or the model has no such series.
+    pub(super) fn variational_series(&self, columns: &mut [Series<N>], order: usize) -> bool {
+        self.room
+            .as_deref()
+            .is_some_and(|r| r.variational(columns, order))
+    }
+
     /// The state (q, q̇) at τ on the step's series.
     fn series_state(&self, tau: f64) -> Result<QV<N>, SimError<M::Wall>> {
         Ok(self.series().ok_or(SimError::NoSeries)?.state(tau))

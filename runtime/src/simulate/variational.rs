@@ -12,10 +12,22 @@
 //!   length (up to the collision instant for a step that ends at one). So
 //!   each column of Φ is the derivative of the computed solution, with
 //!   no tolerance of its own, at 2N tangents a stage;
-//! - after a step of Taylor's method, the variational equation Φ̇ =
-//!   J(x(t)) Φ, J = [[0, I], [∂q̈/∂q, ∂q̈/∂q̇]], is integrated column by
-//!   column along the step's polynomial ([`Simulator::state_at`]) by
-//!   Dormand–Prince 5(4) with its own error control.
+//! - after a step of Taylor's method, each column of Φ is carried by a
+//!   polynomial: the model's series of the variational equation
+//!   Φ̇ = J(x(t)) Φ, J = [[0, I], [∂q̈/∂q, ∂q̈/∂q̇]], along the step's
+//!   series ([`TaylorSeries::variational_series`], the Taylor transform of
+//!   the tangent of q̈), evaluated at the step's length (or the collision
+//!   instant). At the step's order each column is the derivative of the
+//!   step's polynomial along its start. That order was chosen for the
+//!   motion's terms, and a perturbation's may fall more slowly (a flight
+//!   that is a polynomial of low degree, perturbed off it), so each
+//!   column's last two terms at the step's length are held to Φ's
+//!   tolerance: where they are above it, the series are taken to
+//!   [`MAX_ORDER`] along the motion's extended to that order, and where
+//!   they still are, or the model has no such series, the variational
+//!   equation is integrated along the step's polynomial
+//!   ([`Simulator::state_at`]) by Dormand–Prince 5(4) with its own error
+//!   control.
 //!
 //! The step lengths and collision instants are not differentiated: the
 //! instants' dependence on x₀ is the saltation matrix's part, and a
@@ -34,12 +46,14 @@
 //! [`parameter_jump`].
 //!
 //! [`Dynamics::accelerations_tangent`]: crate::Dynamics::accelerations_tangent
+//! [`TaylorSeries::variational_series`]: crate::TaylorSeries::variational_series
 
 use super::integrator::{DormandPrince, Engine, Method, RungeKutta};
 use super::phase::{Combine, Dual, Phase};
 use super::{LastStep, Simulator, Step};
 use crate::Surfaces;
 use crate::saltation::{SaltationError, StateMatrix, parameter_jump, saltation};
+use crate::taylor::{Coefficients, MAX_ORDER, Series};
 
 /// Φ along a simulation (see the module doc). Start it at the simulator's
 /// start and call [`Variational::follow`] after every step:
@@ -143,7 +157,9 @@ impl<const N: usize> Variational<N> {
         sim: &Simulator<'_, M, N>,
         step: &Step<M::Wall, N>,
     ) -> Result<(), VariationalError<M::Wall>> {
-        if let Some(flight) = Flight::of(sim, step)? {
+        if let Some(flight) = Flight::of(sim, step)?
+            && !self.along_series(&flight)?
+        {
             for j in 0..2 * N {
                 let column = flight.carry(self.column(j), tangent, self.method, &mut self.h)?;
                 self.set_column(j, &column);
@@ -165,6 +181,78 @@ impl<const N: usize> Variational<N> {
             self.phi = s.matrix.mul(&self.phi);
         }
         Ok(())
+    }
+
+    /// Φ carried over a step of Taylor's method by the model's variational
+    /// series (module doc); `false`, with Φ untouched, for any other step,
+    /// a model without that series, or columns whose series stay above
+    /// Φ's tolerance at the step's length. The series are taken to the
+    /// step's order first, then, where a column's last two terms are above
+    /// the tolerance, to [`MAX_ORDER`] along the motion's series extended
+    /// to it: a perturbation's series may converge more slowly than the
+    /// motion's, whose own terms chose the step (a flight whose motion is
+    /// a polynomial of low degree, perturbed off it). (An order estimated
+    /// from the rate at which the terms fall was tried in between: on
+    /// §3.2.1's bounce it cost 7 % more than going to [`MAX_ORDER`].)
+    fn along_series<M: Surfaces<N>>(
+        &mut self,
+        flight: &Flight<'_, '_, M, N>,
+    ) -> Result<bool, VariationalError<M::Wall>> {
+        let (sim, last) = (flight.sim, flight.last);
+        let Some(series) = sim.series().filter(|_| last.interpolant.is_none()) else {
+            return Ok(false);
+        };
+        for order in [series.order, MAX_ORDER] {
+            match self.by_series(flight, order)? {
+                BySeries::Carried(phi) => {
+                    self.phi = phi;
+                    return Ok(true);
+                }
+                BySeries::None => return Ok(false),
+                BySeries::Inaccurate => {}
+            }
+        }
+        Ok(false)
+    }
+
+    /// Φ over `flight` by the variational series to `order` (see
+    /// [`Variational::along_series`]).
+    fn by_series<M: Surfaces<N>>(
+        &self,
+        flight: &Flight<'_, '_, M, N>,
+        order: usize,
+    ) -> Result<BySeries<N>, VariationalError<M::Wall>> {
+        let last = flight.last;
+        let tau = (flight.t1 - last.t0) - last.t0_low;
+        let (rtol, atol) = (self.method.rtol, self.method.atol);
+        let mut phi = *self;
+        let mut columns: [Series<N>; N] =
+            core::array::from_fn(|_| Series::at(&[0.0; N], &[0.0; N]));
+        for half in 0..2 {
+            for (k, c) in columns.iter_mut().enumerate() {
+                let column = self.column(half * N + k);
+                c.restart(&column.q, &column.v);
+            }
+            if !flight.sim.variational_series(&mut columns, order) {
+                return Ok(BySeries::None);
+            }
+            for (k, c) in columns.iter().enumerate() {
+                let (q, v) = c.state(tau);
+                if !q.iter().chain(&v).all(|x| x.is_finite()) {
+                    return Err(VariationalError::Integration { t: flight.t0 });
+                }
+                // The last two terms at τ, against Φ's tolerance.
+                let within = |(x, value): (&Coefficients, f64)| {
+                    let term = |k: usize| x[k].abs() * libm::pow(tau, k as f64);
+                    term(c.order) + term(c.order.saturating_sub(1)) <= atol + rtol * value.abs()
+                };
+                if !(c.q.iter().zip(q).chain(c.v.iter().zip(v))).all(within) {
+                    return Ok(BySeries::Inaccurate);
+                }
+                phi.set_column(half * N + k, &Phase { q, v });
+            }
+        }
+        Ok(BySeries::Carried(phi.phi))
     }
 
     fn column(&self, j: usize) -> Phase<N> {
@@ -300,6 +388,16 @@ impl<'p, const N: usize> ParameterSensitivity<'p, N> {
         }
         Ok(())
     }
+}
+
+/// What the variational series gave over a step.
+enum BySeries<const N: usize> {
+    /// Φ at the step's end.
+    Carried(StateMatrix<N>),
+    /// No series (the model has none).
+    None,
+    /// A column's series above Φ's tolerance at the step's length.
+    Inaccurate,
 }
 
 /// The motion of one step up to its collision (or its end), along which

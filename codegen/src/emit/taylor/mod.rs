@@ -69,26 +69,14 @@ pub(super) fn functions(d: &Ctx) -> TokenStream {
     let n = Literal::usize_unsuffixed(d.model.velocities.len());
     let plan = pairs::plan(motion);
     let motion_prelude = prelude(d, motion, &plan);
+    let tangent_fn = d.plan.variational.as_ref().map(|t| tangent_series(d, t));
     if let Some(solve) = motion.solve.as_ref().filter(|s| s.momentum) {
         let walls = wall_functions(d, walls, &n);
         let motion_fn = momentum_series(d, motion, solve, &plan, motion_prelude, &n);
-        return quote! { #motion_fn #walls };
+        return quote! { #motion_fn #walls #tangent_fn };
     }
     let motion_ops = ops(d, motion, &plan.groups[0]);
-    let feedback = (0..d.model.velocities.len()).map(|i| {
-        let i_lit = Literal::usize_unsuffixed(i);
-        // A zero acceleration (a free coordinate) is zero at every order.
-        let out = if zero_output(motion, i) {
-            quote! { 0.0 }
-        } else {
-            let out = output(d, motion, i);
-            quote! { #out * ik }
-        };
-        quote! {
-            s.q[#i_lit][k + 1] = s.v[#i_lit][k] * ik;
-            s.v[#i_lit][k + 1] = #out;
-        }
-    });
+    let feedback = (0..d.model.velocities.len()).map(|i| feedback(d, motion, i, i));
     let how: &[&str] = if motion.solve.is_some() {
         &[
             " `taylor::MAX_ORDER`) by the Taylor transform of G and h",
@@ -115,7 +103,75 @@ pub(super) fn functions(d: &Ctx) -> TokenStream {
         }
     };
     let wall_fns = wall_functions(d, walls, &n);
-    quote! { #motion_fn #wall_fns }
+    quote! { #motion_fn #wall_fns #tangent_fn }
+}
+
+/// `tangent_series`: the series of columns of the variational flow along
+/// the motion's series, by the transform of the variational system over
+/// (q, δq) ([`crate::program::Program::variational`]). The function copies
+/// the motion's coefficients into the first half of one series of
+/// dimension 2N (`s`, which the ops read as `motion_series` reads its
+/// own), runs the ops shared by every column to the last order
+/// ([`Transform::shared`]), then for each column puts its start into the
+/// second half and runs the other ops order by order; the feedback fills
+/// the second half alone, the first being the motion's already.
+fn tangent_series(d: &Ctx, t: &Transform) -> TokenStream {
+    let n = d.model.velocities.len();
+    let (nl, n2) = (
+        Literal::usize_unsuffixed(n),
+        Literal::usize_unsuffixed(2 * n),
+    );
+    let plan = pairs::plan(t);
+    let prelude = prelude(d, t, &plan);
+    let (shared, ops) = match &plan.groups[..] {
+        [shared, rest] => (ops(d, t, shared), ops(d, t, rest)),
+        _ => unreachable!("a variational system's ops are shared or not"),
+    };
+    let feedback = (0..n).map(|i| feedback(d, t, i, n + i));
+    let lints = lints();
+    let scratch = room::needs_room(t).then(|| {
+        quote! { let scratch = &mut VariationalScratch::default(); }
+    });
+    quote! {
+        /// Columns of the variational flow along the motion's series `motion`
+        /// (`motion_series`'s): each of `columns` holds (δq, δq̇) at order 0,
+        /// and gets its coefficients of orders 1 to `motion.order`, the
+        /// series of δq(t), δq̇(t) under δq̈ = ∂q̈/∂q δq + ∂q̈/∂q̇ δq̇ (the
+        /// Taylor transform of `accelerations_tangent`): each column's
+        /// polynomial is the derivative of the motion's along its start.
+        #lints
+        pub fn tangent_series(
+            &self,
+            motion: &::dalembert_runtime::taylor::Series<#nl>,
+            columns: &mut [::dalembert_runtime::taylor::Series<#nl>],
+        ) {
+            let order = motion.order.min(::dalembert_runtime::taylor::MAX_ORDER);
+            #scratch
+            #prelude
+            let mut both = ::dalembert_runtime::taylor::Series::<#n2>::at(&[0.0; #n2], &[0.0; #n2]);
+            both.q[..#nl].copy_from_slice(&motion.q);
+            both.v[..#nl].copy_from_slice(&motion.v);
+            let s = &mut both;
+            for k in 0..order {
+                #shared
+            }
+            for column in columns.iter_mut() {
+                let s = &mut both;
+                for i in 0..#nl {
+                    s.q[#nl + i][0] = column.q[i][0];
+                    s.v[#nl + i][0] = column.v[i][0];
+                }
+                for k in 0..order {
+                    #ops
+                    let ik = ::dalembert_runtime::__private::taylor::RECIPROCALS[k + 1];
+                    #(#feedback)*
+                }
+                column.q.copy_from_slice(&s.q[#nl..]);
+                column.v.copy_from_slice(&s.v[#nl..]);
+                column.order = order;
+            }
+        }
+    }
 }
 
 /// Every `{wall}_surface_series`.
@@ -199,6 +255,23 @@ fn momentum_series(
             }
             s.order = order;
         }
+    }
+}
+
+/// Coefficient k + 1 of coordinate and velocity `i` of `s` from
+/// coefficient k of the velocity and of output `o` (its acceleration).
+fn feedback(d: &Ctx, t: &Transform, o: usize, i: usize) -> TokenStream {
+    let i = Literal::usize_unsuffixed(i);
+    // A zero acceleration (a free coordinate) is zero at every order.
+    let out = if zero_output(t, o) {
+        quote! { 0.0 }
+    } else {
+        let out = output(d, t, o);
+        quote! { #out * ik }
+    };
+    quote! {
+        s.q[#i][k + 1] = s.v[#i][k] * ik;
+        s.v[#i][k + 1] = #out;
     }
 }
 

@@ -99,8 +99,13 @@ impl Group {
 
 /// A transform's groups, in the order its function runs them: with the
 /// momentum's solve, the ops that read coordinates and the solve, then the
-/// rest; otherwise all ops (and the solve of G q̈ = −h, if any).
+/// rest; for the variational system, the ops shared by every column, then
+/// the rest; otherwise all ops (and the solve of G q̈ = −h, if any).
 fn groups(t: &Transform) -> Vec<Group> {
+    if let Some(shared) = t.shared {
+        let group = |ops| Group { ops, solve: false };
+        return vec![group(0..shared), group(shared..t.ops.len())];
+    }
     match &t.solve {
         Some(solve) if solve.momentum => vec![
             Group {

@@ -15,33 +15,66 @@ use crate::quantity::Inputs;
 /// `SeriesScratch`: room for the intermediate series of every function
 /// above, one pool they share (they never run at once), as long as the
 /// longest list of [`arrays`], and one pool of lanes (pairs of series side
-/// by side, [`pairs`]) as long as the most any of them uses.
+/// by side, [`pairs`]) as long as the most any of them uses; and
+/// `VariationalScratch`, the same for the variational series, which that
+/// function keeps on its stack for one call (so that a simulator without
+/// Φ carries none of it).
 pub(in crate::emit) fn scratch_struct(d: &Ctx) -> TokenStream {
     let Some((motion, walls)) = d.series() else {
         return TokenStream::new();
     };
-    let most = |count: &dyn Fn(&Transform) -> usize| {
-        std::iter::once(motion)
-            .chain(walls)
-            .map(count)
-            .max()
-            .unwrap_or(0)
-    };
+    let series = room(
+        format_ident!("SeriesScratch"),
+        std::iter::once(motion).chain(walls),
+        quote! {
+            /// Room for the intermediate series of `motion_series` and the
+            /// walls' `surface_series` (`TaylorSeries::SeriesScratch`), kept by
+            /// the caller from one call to the next: a call writes each
+            /// coefficient before it reads it, so nothing needs clearing
+            /// between calls.
+        },
+    );
+    let variational = d
+        .plan
+        .variational
+        .as_ref()
+        .filter(|t| needs_room(t))
+        .map(|t| {
+            room(
+                format_ident!("VariationalScratch"),
+                std::iter::once(t),
+                quote! {
+                    /// Room for the intermediate series of `tangent_series`, on its
+                    /// stack for the call.
+                },
+            )
+        });
+    quote! { #series #variational }
+}
+
+/// Whether `t`'s function keeps intermediate series in a scratch room
+/// (whole arrays, or lanes).
+pub(super) fn needs_room(t: &Transform) -> bool {
+    !arrays(t).is_empty() || pairs::plan(t).lanes > 0
+}
+
+/// A struct named `name` with room for the intermediate series of any one
+/// of `transforms` at a time.
+fn room<'t>(
+    name: proc_macro2::Ident,
+    transforms: impl Iterator<Item = &'t Transform> + Clone,
+    doc: TokenStream,
+) -> TokenStream {
+    let most =
+        |count: &dyn Fn(&Transform) -> usize| transforms.clone().map(count).max().unwrap_or(0);
     let len = most(&|t| arrays(t).len());
     let lanes = most(&|t| pairs::plan(t).lanes);
-    let doc = quote! {
-        /// Room for the intermediate series of `motion_series` and the
-        /// walls' `surface_series` (`TaylorSeries::SeriesScratch`), kept by
-        /// the caller from one call to the next: a call writes each
-        /// coefficient before it reads it, so nothing needs clearing
-        /// between calls.
-    };
     if len == 0 && lanes == 0 {
         return quote! {
             #doc
             /// (This model's series keep every intermediate on the stack.)
             #[derive(Clone, Copy, Debug, Default)]
-            pub struct SeriesScratch;
+            pub struct #name;
         };
     }
     let tay = quote! { ::dalembert_runtime::__private::taylor };
@@ -59,8 +92,8 @@ pub(in crate::emit) fn scratch_struct(d: &Ctx) -> TokenStream {
     quote! {
         #doc
         #[derive(Clone, Debug)]
-        pub struct SeriesScratch { #(#fields)* }
-        impl Default for SeriesScratch {
+        pub struct #name { #(#fields)* }
+        impl Default for #name {
             fn default() -> Self {
                 Self { #(#values)* }
             }

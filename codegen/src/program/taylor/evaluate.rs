@@ -233,6 +233,35 @@ impl Transform {
         }
     }
 
+    /// The ops every column of the variational flow shares
+    /// ([`Transform::shared`]) along the motion in `e` (its n series,
+    /// then room for a column's n), to `order`.
+    pub fn shared_into(&self, e: &mut Evaluation, numbers: &[f64], order: usize) {
+        e.temps.resize(self.temps, [0.0; tay::CAPACITY]);
+        let shared = self.shared.expect("a variational system");
+        for k in 0..order.min(tay::MAX_ORDER) {
+            self.run_ops(e, numbers, k, 0..shared);
+        }
+    }
+
+    /// A column of the variational flow along a motion, this transform
+    /// being the variational system's ([`Program::variational`]), after
+    /// [`Transform::shared_into`]: `e.q` and `e.v` hold the motion's n
+    /// series (to `order`) followed by the column's n, whose orders 1 to
+    /// `order` it fills from order 0 (as emitted `tangent_series` does).
+    pub fn tangent_into(&self, e: &mut Evaluation, numbers: &[f64], order: usize) {
+        let n = e.q.len() / 2;
+        let shared = self.shared.expect("a variational system");
+        for k in 0..order.min(tay::MAX_ORDER) {
+            self.run_ops(e, numbers, k, shared..self.ops.len());
+            let ik = tay::RECIPROCALS[k + 1];
+            for i in 0..n {
+                e.q[n + i][k + 1] = e.v[n + i][k] * ik;
+                e.v[n + i][k + 1] = self.output(e, numbers, i, k) * ik;
+            }
+        }
+    }
+
     /// The coefficients of the first output along the coordinates' series
     /// in `e` (its temporaries overwritten), orders 0 to `order`.
     pub fn along(&self, numbers: &[f64], e: &mut Evaluation, order: usize) -> Coefficients {

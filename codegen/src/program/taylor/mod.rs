@@ -12,7 +12,7 @@
 //! series one pair. Slots that the program writes again get a fresh series
 //! each time, so every coefficient can be kept.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use dalembert_runtime::taylor::Work;
 
@@ -119,6 +119,9 @@ pub struct Transform {
     /// that follows the ops at each order and writes the series the
     /// outputs read.
     pub solve: Option<Solve>,
+    /// For the variational system ([`Transform::shared`]): the first this
+    /// many ops read no tangent series, and are run once for every column.
+    pub shared: Option<usize>,
 }
 
 impl Program {
@@ -186,6 +189,7 @@ impl<'a> Builder<'a> {
             ops,
             outputs,
             solve: None,
+            shared: None,
         }
     }
 
@@ -407,6 +411,33 @@ impl Op {
 }
 
 impl Transform {
+    /// The same transform with the ops that read no series of coordinate
+    /// or velocity `n` or beyond (directly or through other ops) moved
+    /// first, in order, and their count in [`Transform::shared`]: for a
+    /// variational system over (q, δq) with `n` coordinates, the motion's
+    /// part, the same for every column of Φ. Values are unchanged: the ops
+    /// moved read nothing the others write.
+    pub fn shared(mut self, n: usize) -> Self {
+        let mut tangent: HashSet<Series> = HashSet::new();
+        let is_tangent = |s: &Series, tangent: &HashSet<Series>| match *s {
+            Series::Q(i) | Series::V(i) => i >= n,
+            Series::Temp(_) => tangent.contains(s),
+        };
+        let mut reads_tangent = Vec::with_capacity(self.ops.len());
+        for op in &self.ops {
+            let t = op.reads().iter().any(|s| is_tangent(s, &tangent));
+            if t {
+                tangent.extend(op.writes());
+            }
+            reads_tangent.push(t);
+        }
+        let (first, rest): (Vec<_>, Vec<_>) =
+            (self.ops.into_iter().zip(reads_tangent)).partition(|(_, t)| !t);
+        self.shared = Some(first.len());
+        self.ops = first.into_iter().chain(rest).map(|(op, _)| op).collect();
+        self
+    }
+
     /// The work of the series to `order`, in multiply-adds
     /// ([`Work::multiply_adds`]: each convolution sums k − 1 products of its
     /// history at order k, and every operation is finished once per order;
@@ -466,6 +497,19 @@ impl Transform {
         if let Some(solve) = &self.solve {
             solve.varying().for_each(|(_, _, s, _)| keep(&s));
             solve.x.iter().for_each(&mut keep);
+        }
+        // The shared ops run to the last order before the others start,
+        // so what they write and the others read is kept whole.
+        if let Some(shared) = self.shared {
+            let early: HashSet<Series> = self.ops[..shared].iter().flat_map(Op::writes).collect();
+            let outputs = self.outputs.iter().filter_map(|t| match *t {
+                Term::Series(s) | Term::Negated(s) => Some(s),
+                Term::Number(_) => None,
+            });
+            (self.ops[shared..].iter().flat_map(Op::reads))
+                .chain(outputs)
+                .filter(|s| early.contains(s))
+                .for_each(|s| keep(&s));
         }
         only
     }
