@@ -202,7 +202,9 @@ impl<const N: usize> Variational<N> {
         let Some(series) = sim.series().filter(|_| last.interpolant.is_none()) else {
             return Ok(false);
         };
-        for order in [series.order, MAX_ORDER] {
+        let orders = [series.order, MAX_ORDER];
+        let tries = if series.order < MAX_ORDER { 2 } else { 1 };
+        for &order in &orders[..tries] {
             match self.by_series(flight, order)? {
                 BySeries::Carried(phi) => {
                     self.phi = phi;
