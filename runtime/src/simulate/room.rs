@@ -81,16 +81,12 @@ impl<M: TaylorSeries<N>, const N: usize> Room<N> for SeriesRoom<'_, M, N> {
         if order <= self.series.order {
             return self.model.variational_series(&self.series, columns);
         }
-        // The same series to a higher order: its coefficients up to its
-        // own order are the same (each order's recurrence reads lower
-        // ones only), computed in room of its own (the scratch is the
-        // simulator's, and this reads the room).
+        // The same series to a higher order (the motion's series is
+        // filled from order 0): its coefficients up to its own order are
+        // the same (each order's recurrence reads lower ones only),
+        // computed in room of its own (the scratch is the simulator's, and
+        // this reads the room).
         let mut longer = self.series;
-        let (q, v) = (
-            core::array::from_fn(|i| longer.q[i][0]),
-            core::array::from_fn(|i| longer.v[i][0]),
-        );
-        longer.restart(&q, &v);
         let scratch = &mut M::SeriesScratch::default();
         self.model.taylor_series(&mut longer, scratch, order)
             && self.model.variational_series(&longer, columns)
