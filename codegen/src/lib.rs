@@ -17,8 +17,9 @@
 //!    run by a register machine behind the runtime's traits.
 //!
 //! Between the stages: [`quantity`], the table of emitted functions that
-//! stages 2 to 4 share, [`program`] and [`diag`]. No stage imports a later
-//! one.
+//! stages 2 to 4 share, [`program`] and [`diag`]; below them all,
+//! [`function`], the language's functions, one file each, with every rule
+//! each stage needs of them. No stage imports a later one.
 //!
 //! Front ends: [`compile_dir`] for build scripts (see the workspace's
 //! `build.rs`), [`generate`] and [`fn@derive`] for the CLI and for tests.
@@ -29,6 +30,7 @@
 pub mod derive;
 pub mod diag;
 pub mod emit;
+pub mod function;
 pub mod interpret;
 pub mod ir;
 pub mod lock;

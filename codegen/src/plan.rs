@@ -225,7 +225,7 @@ fn variational(d: &Derivation, motion: &Transform) -> Option<Transform> {
 mod tests {
     use super::*;
     use crate::program::machine::Operand;
-    use crate::program::{Func, Instr, Slot};
+    use crate::program::{Function, Instr, Slot};
 
     /// Inputs (m, x) with m a parameter: −m·x has its leading −1·m kept
     /// once (the −1 as the kept value's negation) and read per call;
@@ -239,8 +239,8 @@ mod tests {
             consts: vec![-1.0],
             instrs: vec![
                 Instr::Mul(Slot::Out(0), vec![m, Slot::Const(0), x]),
-                Instr::Fun(Slot::Temp(0), Func::Sin, x),
-                Instr::Fun(Slot::Temp(1), Func::Cos, x),
+                Instr::Fun(Slot::Temp(0), Function::Sin, x),
+                Instr::Fun(Slot::Temp(1), Function::Cos, x),
                 Instr::Pow(Slot::Temp(2), m, -1),
                 Instr::Add(
                     Slot::Out(1),

@@ -231,6 +231,12 @@ impl Interval {
         self.periodic(libm::cos, 0.0)
     }
 
+    /// The tangent, as sin/cos (everything where cos may be 0).
+    pub fn tan(self) -> Self {
+        let (s, c) = self.sincos();
+        s / c
+    }
+
     /// Sine and cosine.
     pub fn sincos(self) -> (Self, Self) {
         (self.sin(), self.cos())

@@ -18,7 +18,7 @@ use std::ops::Range;
 
 use symbolica::prelude::*;
 
-use crate::ir::expr::derivative::{Algebra, derivative};
+use crate::function::Algebra;
 use crate::ir::{Constant, Function, Node, NodeKind, Rational};
 
 thread_local! {
@@ -92,20 +92,26 @@ fn made_place(i: usize) -> Symbol {
     symbol!(format!("dalembert_places::x{i}").as_str())
 }
 
-/// The functions of the language symbolica does not have, as functions of
-/// ours (atan, asin, acos, sinh, cosh, tanh).
-pub const OWN_FUNCTIONS: [Function; 6] = [
-    Function::Atan,
-    Function::Asin,
-    Function::Acos,
-    Function::Sinh,
-    Function::Cosh,
-    Function::Tanh,
+/// The functions of the language symbolica has, or writes with its own
+/// (tan as sin/cos, a root as a power ½): [`applied`] says how.
+const NATIVE: [Function; 6] = [
+    Function::Sin,
+    Function::Cos,
+    Function::Tan,
+    Function::Exp,
+    Function::Log,
+    Function::Sqrt,
 ];
 
-/// The symbols of [`OWN_FUNCTIONS`] in the current namespace.
+/// The functions of the language symbolica does not have: every other one
+/// (atan, asin, acos, sinh, cosh, tanh), each a function of ours.
+pub fn own_function_list() -> impl Iterator<Item = Function> {
+    Function::ALL.into_iter().filter(|f| !NATIVE.contains(f))
+}
+
+/// The symbols of [`own_function_list`] in the current namespace.
 pub fn own_functions() -> impl Iterator<Item = Symbol> {
-    OWN_FUNCTIONS.into_iter().map(|f| own_symbol(f.name()))
+    own_function_list().map(|f| own_symbol(f.name()))
 }
 
 /// Differentiation that knows the functions of ours: symbolica leaves
@@ -133,9 +139,8 @@ fn resolved(a: AtomView) -> Option<Atom> {
             if f.get_symbol().get_stripped_name() == "der"
                 && let [n, AtomView::Var(g), z] = args[..]
                 && n.to_owned() == Atom::num(1)
-                && let Some(rule) = OWN_FUNCTIONS
-                    .into_iter()
-                    .find(|h| own_symbol(h.name()) == g.get_symbol())
+                && let Some(rule) =
+                    own_function_list().find(|h| own_symbol(h.name()) == g.get_symbol())
             {
                 return Some(derivative_rule(rule, or_same(z)));
             }
@@ -178,7 +183,7 @@ fn resolved(a: AtomView) -> Option<Atom> {
 /// ([`derivative`]).
 fn derivative_rule(f: Function, z: Atom) -> Atom {
     let y = applied(f, z.clone());
-    let factors = derivative(&mut Atoms, f, z, y);
+    let factors = f.derivative(&mut Atoms, z, y);
     factors.into_iter().fold(Atom::num(1), |acc, x| acc * x)
 }
 
@@ -214,12 +219,7 @@ fn applied(f: Function, x: Atom) -> Atom {
         Function::Exp => function!(Symbol::EXP, x),
         Function::Log => function!(Symbol::LOG, x),
         Function::Sqrt => x.pow(Atom::num(1) / Atom::num(2)),
-        Function::Atan
-        | Function::Asin
-        | Function::Acos
-        | Function::Sinh
-        | Function::Cosh
-        | Function::Tanh => function!(own_symbol(f.name()), x),
+        _ => function!(own_symbol(f.name()), x),
     }
 }
 

@@ -24,7 +24,7 @@ use super::atoms::children;
 use super::build::{constant_symbol, own_functions, place};
 use super::coefficients;
 use crate::ir::Constant;
-use crate::program::{Func, Instr, Program, Slot};
+use crate::program::{Function, Instr, Program, Slot};
 
 /// The place of π, and the place of e ([`place`]).
 const PI: usize = 0;
@@ -124,14 +124,14 @@ fn program_in_places(outputs: &[Atom], inputs: usize) -> Result<Program, String>
     };
     let mut stage: Option<Program> = None;
     loop {
-        let mut ready: Vec<(Atom, Func)> = Vec::new();
+        let mut ready: Vec<(Atom, Function)> = Vec::new();
         for o in outputs {
             innermost(replaced(o, &known).as_view(), &ours, &mut ready);
         }
         if ready.is_empty() {
             break;
         }
-        let mut unique: Vec<(Atom, Func)> = Vec::new();
+        let mut unique: Vec<(Atom, Function)> = Vec::new();
         for r in ready {
             if !unique.iter().any(|u| u.0 == r.0) {
                 unique.push(r);
@@ -164,14 +164,14 @@ fn program_in_places(outputs: &[Atom], inputs: usize) -> Result<Program, String>
 
 /// The applications of the functions `ours` in `a` whose argument has none
 /// of them, each with its function.
-fn innermost(a: AtomView, ours: &[Symbol], out: &mut Vec<(Atom, Func)>) {
+fn innermost(a: AtomView, ours: &[Symbol], out: &mut Vec<(Atom, Function)>) {
     let parts = children(a);
     if let AtomView::Fun(f) = a
         && ours.contains(&f.get_symbol())
         && !parts.iter().any(|x| contains_own(*x, ours))
     {
         let symbol = f.get_symbol();
-        let func = Func::from_name(symbol.get_stripped_name()).expect("a function of ours");
+        let func = Function::from_name(symbol.get_stripped_name()).expect("a function of ours");
         out.push((a.to_owned(), func));
         return;
     }
@@ -267,23 +267,25 @@ fn plain_program(outputs: &[Atom], inputs: usize) -> Result<Program, String> {
             Instruction::Powf(d, s, e, _) => match (slot(s), slot(e)) {
                 (_, Slot::Const(k)) => Instr::Powf(slot(d), slot(s), consts[k]),
                 // symbolica writes exp(x) as e^x.
-                (Slot::Const(k), x) if k == first_constant + 1 => Instr::Fun(slot(d), Func::Exp, x),
+                (Slot::Const(k), x) if k == first_constant + 1 => {
+                    Instr::Fun(slot(d), Function::Exp, x)
+                }
                 // b^x with x varying (symbolica's form of exp(x·log b)):
                 // written back as exp(x·log b), in the functions the
                 // language has.
                 (b, x) => {
                     let (log, product) = (Slot::Temp(fresh), Slot::Temp(fresh + 1));
                     fresh += 2;
-                    instrs.push(Instr::Fun(log, Func::Log, b));
+                    instrs.push(Instr::Fun(log, Function::Log, b));
                     instrs.push(Instr::Mul(product, vec![x, log]));
-                    Instr::Fun(slot(d), Func::Exp, product)
+                    Instr::Fun(slot(d), Function::Exp, product)
                 }
             },
             Instruction::Assign(d, s) => Instr::Assign(slot(d), slot(s)),
             Instruction::Fun(d, call, _) => {
                 let (f, _, args) = call.as_ref();
                 let name = f.get_stripped_name();
-                let func = Func::from_name(name)
+                let func = Function::from_name(name)
                     .ok_or_else(|| format!("unsupported function `{name}` in evaluator"))?;
                 let [arg] = args.as_slice() else {
                     return Err(format!("`{name}` takes one argument"));
@@ -363,7 +365,7 @@ mod tests {
         let calls = p
             .instrs
             .iter()
-            .filter(|i| matches!(i, Instr::Fun(_, Func::Tanh, _)))
+            .filter(|i| matches!(i, Instr::Fun(_, Function::Tanh, _)))
             .count();
         assert_eq!(calls, 1, "tanh(xy) computed once");
         let f = |a: f64, b: f64| {

@@ -20,7 +20,7 @@ use dalembert_runtime::interval::Interval;
 use dalembert_runtime::libm;
 
 use crate::program::machine::{Machine, Operand, lower};
-use crate::program::{Func, Program, Slot};
+use crate::program::{Function, Program, Slot};
 
 /// What an operation does.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -53,7 +53,7 @@ enum Kind {
     /// libm's sincos(a): sin into d, cos into b.
     SinCos,
     /// libm's function of that name.
-    Call(Func),
+    Call(Function),
 }
 
 /// One operation: destination `d` and operands `a`, `b`, as its kind uses
@@ -252,7 +252,7 @@ pub(super) trait Register:
     /// sin x and cos x.
     fn sincos(self) -> (Self, Self);
     /// The function `f` on this kind of value.
-    fn function(f: Func) -> fn(Self) -> Self;
+    fn function(f: Function) -> fn(Self) -> Self;
 }
 
 impl Register for f64 {
@@ -278,7 +278,7 @@ impl Register for f64 {
     fn sincos(self) -> (Self, Self) {
         libm::sincos(self)
     }
-    fn function(f: Func) -> fn(Self) -> Self {
+    fn function(f: Function) -> fn(Self) -> Self {
         f.libm()
     }
 }
@@ -302,7 +302,7 @@ impl Register for Interval {
     fn sincos(self) -> (Self, Self) {
         Interval::sincos(self)
     }
-    fn function(f: Func) -> fn(Self) -> Self {
+    fn function(f: Function) -> fn(Self) -> Self {
         f.interval()
     }
 }
@@ -458,11 +458,11 @@ mod tests {
                 Instr::Pow(Slot::Out(2), x, -11),
                 Instr::Powf(Slot::Out(3), y, -0.5),
                 Instr::Powf(Slot::Out(4), y, 1.5),
-                Instr::Fun(t1, Func::Sin, x),
-                Instr::Fun(Slot::Out(5), Func::Exp, t1),
+                Instr::Fun(t1, Function::Sin, x),
+                Instr::Fun(Slot::Out(5), Function::Exp, t1),
                 Instr::Mul(Slot::Out(6), vec![Slot::Const(0), Slot::Const(0)]),
                 Instr::Assign(Slot::Out(7), t0),
-                Instr::Fun(Slot::Out(8), Func::Cos, x),
+                Instr::Fun(Slot::Out(8), Function::Cos, x),
                 Instr::Add(t0, vec![t0, t1]),
                 Instr::Mul(Slot::Out(9), vec![t0, t0]),
                 Instr::Sub(Slot::Out(11), [y, t1]),

@@ -34,100 +34,7 @@ pub const MAX_DEGREE: u64 = 400;
 /// Longest expression, in bytes.
 pub const MAX_LEN: usize = 64 * 1024;
 
-/// A function of the language.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Function {
-    /// sin
-    Sin,
-    /// cos
-    Cos,
-    /// tan
-    Tan,
-    /// exp
-    Exp,
-    /// natural logarithm
-    Log,
-    /// square root
-    Sqrt,
-    /// arctangent
-    Atan,
-    /// arcsine
-    Asin,
-    /// arccosine
-    Acos,
-    /// hyperbolic sine
-    Sinh,
-    /// hyperbolic cosine
-    Cosh,
-    /// hyperbolic tangent
-    Tanh,
-}
-
-impl Function {
-    /// Every function, as the format documents them.
-    pub const ALL: [Function; 12] = [
-        Self::Sin,
-        Self::Cos,
-        Self::Tan,
-        Self::Exp,
-        Self::Log,
-        Self::Sqrt,
-        Self::Atan,
-        Self::Asin,
-        Self::Acos,
-        Self::Sinh,
-        Self::Cosh,
-        Self::Tanh,
-    ];
-
-    /// Its value at `x` (f64, the standard library's).
-    pub fn value(self, x: f64) -> f64 {
-        match self {
-            Self::Sin => x.sin(),
-            Self::Cos => x.cos(),
-            Self::Tan => x.tan(),
-            Self::Exp => x.exp(),
-            Self::Log => x.ln(),
-            Self::Sqrt => x.sqrt(),
-            Self::Atan => x.atan(),
-            Self::Asin => x.asin(),
-            Self::Acos => x.acos(),
-            Self::Sinh => x.sinh(),
-            Self::Cosh => x.cosh(),
-            Self::Tanh => x.tanh(),
-        }
-    }
-
-    /// Its name in model files.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Sin => "sin",
-            Self::Cos => "cos",
-            Self::Tan => "tan",
-            Self::Exp => "exp",
-            Self::Log => "log",
-            Self::Sqrt => "sqrt",
-            Self::Atan => "atan",
-            Self::Asin => "asin",
-            Self::Acos => "acos",
-            Self::Sinh => "sinh",
-            Self::Cosh => "cosh",
-            Self::Tanh => "tanh",
-        }
-    }
-
-    /// By its name in model files.
-    pub fn from_name(name: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|f| f.name() == name)
-    }
-
-    /// Every function's name, in a sentence: "sin, cos, … and tanh".
-    pub fn listed() -> String {
-        let names: Vec<&str> = Self::ALL.iter().map(|f| f.name()).collect();
-        let (last, rest) = names.split_last().expect("functions");
-        format!("{} and {last}", rest.join(", "))
-    }
-}
+pub use crate::function::Function;
 
 /// A constant of the language.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -571,7 +478,6 @@ fn constant_value(node: &Node) -> Result<Rational, ParseError> {
 }
 
 mod constant;
-pub(crate) mod derivative;
 mod walk;
 pub(crate) use walk::multinomial;
 

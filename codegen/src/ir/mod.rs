@@ -26,10 +26,9 @@ use validate::Validator;
 
 pub use expr::{Constant, Function, Node, NodeKind};
 
-/// Names models may not declare: functions, constants and names the
-/// generated code uses itself.
+/// Names models may not declare besides the functions': constants and
+/// names the generated code uses itself.
 pub(crate) const RESERVED: &[&str] = &[
-    "sin", "cos", "tan", "exp", "log", "sqrt", "atan", "asin", "acos", "sinh", "cosh", "tanh",
     "pi", "e", "i", "q", "v", "p", "out", "params", "wall", "self", "Self",
 ];
 

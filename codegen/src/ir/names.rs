@@ -8,7 +8,7 @@ use toml::Spanned;
 
 use super::expr::{Node, NodeKind, parse};
 use super::validate::Validator;
-use super::{Expr, RESERVED, RUST_KEYWORDS, Rational};
+use super::{Expr, Function, RESERVED, RUST_KEYWORDS, Rational};
 use crate::diag::ErrorKind;
 
 impl Validator<'_> {
@@ -86,7 +86,7 @@ pub(super) fn ident_problem(name: &str, symbol: bool) -> Option<String> {
         Some("a name may not contain `__`".into())
     } else if RUST_KEYWORDS.contains(&name) {
         Some("it is a Rust keyword".into())
-    } else if symbol && RESERVED.contains(&name) {
+    } else if symbol && (RESERVED.contains(&name) || Function::from_name(name).is_some()) {
         Some("it is reserved (a function, a constant or a name the generated code uses)".into())
     } else {
         None

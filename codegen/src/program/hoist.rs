@@ -285,7 +285,7 @@ impl Program {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{Func, Instr};
+    use super::super::{Function, Instr};
     use super::*;
 
     /// Inputs (m, J, x) with m and J parameters.
@@ -304,10 +304,10 @@ mod tests {
                 Instr::Mul(t1, vec![Slot::Const(0), Slot::Const(1)]),
                 Instr::Mul(Slot::Out(0), vec![t0, x, t1]),
                 // t0 written again from x: varying.
-                Instr::Fun(t0, Func::Sin, x),
+                Instr::Fun(t0, Function::Sin, x),
                 Instr::Add(Slot::Out(1), vec![t0, m]),
                 // A parameter-only output.
-                Instr::Fun(Slot::Out(2), Func::Exp, j),
+                Instr::Fun(Slot::Out(2), Function::Exp, j),
                 // (m·π/2)·x: the leading two operands computed once.
                 Instr::Mul(Slot::Out(3), vec![m, t1, x]),
                 // A copy of m, read per call.

@@ -9,7 +9,7 @@
 
 use std::collections::HashMap;
 
-use super::{Func, Instr, Program, Slot};
+use super::{Function, Instr, Program, Slot};
 
 /// An operand: a slot of the program, or a parameter-only value kept in the
 /// model (`pre[k]`, see [`super::Emit`]).
@@ -65,7 +65,7 @@ pub enum Machine {
     },
     /// libm's function of that name of x (never sqrt: that is
     /// [`Machine::Sqrt`]).
-    Call(Func, Slot),
+    Call(Function, Slot),
     /// The first of a sin/cos pair: libm's sincos(x) computes both, and
     /// this instruction takes the sine (`sin`) or the cosine.
     SinCos {
@@ -131,7 +131,7 @@ pub fn lower(p: &Program, computed: impl Fn(usize) -> bool) -> Vec<Option<Machin
             }
             Some(match (ins, pair) {
                 (Instr::Fun(_, f, x), Some((k, first))) if halves[*k] == 2 => {
-                    let sin = *f == Func::Sin;
+                    let sin = *f == Function::Sin;
                     if *first {
                         Machine::SinCos {
                             x: *x,
@@ -179,7 +179,7 @@ fn instruction(p: &Program, ins: &Instr) -> Machine {
             e: *e,
             reciprocal: false,
         },
-        Instr::Fun(_, Func::Sqrt, x) => Machine::Sqrt {
+        Instr::Fun(_, Function::Sqrt, x) => Machine::Sqrt {
             x: *x,
             reciprocal: false,
         },
@@ -305,8 +305,8 @@ mod tests {
                 Instr::Pow(Slot::Out(2), x, -3),
                 Instr::Pow(Slot::Out(3), x, 9),
                 Instr::Powf(Slot::Out(4), x, -0.5),
-                Instr::Fun(Slot::Out(5), Func::Cos, y),
-                Instr::Fun(Slot::Out(6), Func::Sin, y),
+                Instr::Fun(Slot::Out(5), Function::Cos, y),
+                Instr::Fun(Slot::Out(6), Function::Sin, y),
             ],
             outputs: 7,
         };
@@ -346,7 +346,7 @@ mod tests {
         // sine is a call of its own.
         let some = lower(&p, |i| i != 5);
         assert_eq!(some[5], None);
-        assert_eq!(some[6], Some(Machine::Call(Func::Sin, y)));
+        assert_eq!(some[6], Some(Machine::Call(Function::Sin, y)));
         // A product split after a kept value.
         let ins = &p.instrs[0];
         assert_eq!(

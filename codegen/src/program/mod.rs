@@ -14,8 +14,7 @@ mod taylor;
 
 use std::collections::HashMap;
 
-use dalembert_runtime::interval::Interval;
-
+pub use crate::function::Function;
 pub use elimination::Layout;
 pub use hoist::{Emit, Role, Split};
 pub use linear::{Entry, stored_signs};
@@ -34,109 +33,6 @@ pub enum Slot {
     Out(usize),
 }
 
-/// A function a program may call.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum Func {
-    /// sin
-    Sin,
-    /// cos
-    Cos,
-    /// exp
-    Exp,
-    /// natural log
-    Log,
-    /// square root (the evaluator's form of a power ½)
-    Sqrt,
-    /// arctangent
-    Atan,
-    /// arcsine
-    Asin,
-    /// arccosine
-    Acos,
-    /// hyperbolic sine
-    Sinh,
-    /// hyperbolic cosine
-    Cosh,
-    /// hyperbolic tangent
-    Tanh,
-}
-
-impl Func {
-    /// Every function, in declaration order.
-    pub const ALL: [Func; 11] = [
-        Self::Sin,
-        Self::Cos,
-        Self::Exp,
-        Self::Log,
-        Self::Sqrt,
-        Self::Atan,
-        Self::Asin,
-        Self::Acos,
-        Self::Sinh,
-        Self::Cosh,
-        Self::Tanh,
-    ];
-
-    /// By name.
-    pub fn from_name(name: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|f| f.name() == name)
-    }
-
-    /// Its name (also the libm function's).
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Sin => "sin",
-            Self::Cos => "cos",
-            Self::Exp => "exp",
-            Self::Log => "log",
-            Self::Sqrt => "sqrt",
-            Self::Atan => "atan",
-            Self::Asin => "asin",
-            Self::Acos => "acos",
-            Self::Sinh => "sinh",
-            Self::Cosh => "cosh",
-            Self::Tanh => "tanh",
-        }
-    }
-
-    /// The libm function of that name: what the emitted code calls, and
-    /// so what every evaluation here calls.
-    pub fn libm(self) -> fn(f64) -> f64 {
-        use dalembert_runtime::libm;
-        match self {
-            Self::Sin => libm::sin,
-            Self::Cos => libm::cos,
-            Self::Exp => libm::exp,
-            Self::Log => libm::log,
-            Self::Sqrt => libm::sqrt,
-            Self::Atan => libm::atan,
-            Self::Asin => libm::asin,
-            Self::Acos => libm::acos,
-            Self::Sinh => libm::sinh,
-            Self::Cosh => libm::cosh,
-            Self::Tanh => libm::tanh,
-        }
-    }
-
-    /// The runtime's interval function of that name: what the emitted
-    /// `_bounds` functions call.
-    pub fn interval(self) -> fn(Interval) -> Interval {
-        match self {
-            Self::Sin => Interval::sin,
-            Self::Cos => Interval::cos,
-            Self::Exp => Interval::exp,
-            Self::Log => Interval::log,
-            Self::Sqrt => Interval::sqrt,
-            Self::Atan => Interval::atan,
-            Self::Asin => Interval::asin,
-            Self::Acos => Interval::acos,
-            Self::Sinh => Interval::sinh,
-            Self::Cosh => Interval::cosh,
-            Self::Tanh => Interval::tanh,
-        }
-    }
-}
-
 /// One instruction.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Instr {
@@ -152,7 +48,7 @@ pub enum Instr {
     /// dst = src^x for a fractional constant x (½ is a square root)
     Powf(Slot, Slot, f64),
     /// dst = f(src)
-    Fun(Slot, Func, Slot),
+    Fun(Slot, Function, Slot),
     /// dst = src
     Assign(Slot, Slot),
 }
@@ -340,8 +236,8 @@ impl Program {
                 let value = (*src, writes.get(src).copied().unwrap_or(0));
                 let entry = calls.entry(value).or_default();
                 match f {
-                    Func::Sin if entry.0.is_none() => entry.0 = Some(i),
-                    Func::Cos if entry.1.is_none() => entry.1 = Some(i),
+                    Function::Sin if entry.0.is_none() => entry.0 = Some(i),
+                    Function::Cos if entry.1.is_none() => entry.1 = Some(i),
                     _ => {}
                 }
             }
@@ -413,11 +309,11 @@ mod tests {
             consts: vec![1.0],
             instrs: vec![
                 Instr::Add(t, vec![x, Slot::Const(0)]),
-                Instr::Fun(Slot::Out(0), Func::Sin, t),
+                Instr::Fun(Slot::Out(0), Function::Sin, t),
                 Instr::Add(t, vec![x, x]),
-                Instr::Fun(Slot::Out(1), Func::Cos, t),
-                Instr::Fun(Slot::Out(2), Func::Cos, x),
-                Instr::Fun(Slot::Out(3), Func::Sin, x),
+                Instr::Fun(Slot::Out(1), Function::Cos, t),
+                Instr::Fun(Slot::Out(2), Function::Cos, x),
+                Instr::Fun(Slot::Out(3), Function::Sin, x),
             ],
             outputs: 4,
         };

@@ -11,9 +11,8 @@
 
 use std::collections::{HashMap, HashSet};
 
-use super::{Func, Instr, Program, Slot, constant};
-use crate::ir::Function;
-use crate::ir::expr::derivative::{Algebra, derivative};
+use super::{Function, Instr, Program, Slot, constant};
+use crate::function::Algebra;
 
 impl Program {
     /// The tangent program along the inputs `from..self.inputs`: its inputs
@@ -295,10 +294,9 @@ impl Tangent {
                     self.product(vec![coefficient, power, dx0()])
                 }
             }
-            // The language's rule (`ir::expr::derivative`), times dx.
+            // The language's rule (`function`), times dx.
             Instr::Fun(_, f, _) => {
-                let f = Function::from_name(f.name()).expect("a function of the language");
-                let mut factors = derivative(self, f, x0, y);
+                let mut factors = f.derivative(self, x0, y);
                 factors.push(dx0());
                 self.product(factors)
             }
@@ -328,16 +326,7 @@ impl Algebra for Tangent {
         }
     }
     fn call(&mut self, f: Function, x: Slot) -> Slot {
-        match Func::from_name(f.name()) {
-            Some(func) => self.emit(|d| Instr::Fun(d, func, x)),
-            // tan, which programs write as sin/cos
-            None => {
-                let sin = self.emit(|d| Instr::Fun(d, Func::Sin, x));
-                let cos = self.emit(|d| Instr::Fun(d, Func::Cos, x));
-                let over = self.emit(|d| Instr::Pow(d, cos, -1));
-                self.product(vec![sin, over])
-            }
-        }
+        self.emit(|d| Instr::Fun(d, f, x))
     }
 }
 
@@ -368,17 +357,17 @@ mod tests {
             consts: vec![2.0, 1.5],
             instrs: vec![
                 Instr::Mul(t(0), vec![p, x, y, Slot::Const(0)]),
-                Instr::Fun(t(1), Func::Sin, t(0)),
-                Instr::Fun(t(2), Func::Cos, x),
+                Instr::Fun(t(1), Function::Sin, t(0)),
+                Instr::Fun(t(2), Function::Cos, x),
                 Instr::Add(t(3), vec![t(1), t(2), p]),
                 Instr::Pow(t(0), t(3), 3),
                 Instr::Pow(t(4), y, -2),
                 Instr::Sub(t(5), [p, t(4)]),
                 Instr::Powf(t(6), y, 1.5),
                 Instr::Powf(t(7), y, 0.5),
-                Instr::Fun(t(8), Func::Exp, t(6)),
-                Instr::Fun(t(9), Func::Log, y),
-                Instr::Fun(t(10), Func::Sqrt, t(8)),
+                Instr::Fun(t(8), Function::Exp, t(6)),
+                Instr::Fun(t(9), Function::Log, y),
+                Instr::Fun(t(10), Function::Sqrt, t(8)),
                 Instr::Mul(t(0), vec![t(0), t(5)]),
                 Instr::Assign(Slot::Out(0), t(0)),
                 Instr::Add(Slot::Out(1), vec![t(7), t(9), t(10)]),
@@ -473,7 +462,7 @@ mod tests {
             inputs: 5,
             consts: vec![],
             instrs: vec![
-                Instr::Fun(Slot::Temp(0), Func::Sin, x),
+                Instr::Fun(Slot::Temp(0), Function::Sin, x),
                 Instr::Mul(Slot::Out(0), vec![p, Slot::Temp(0), vy]),
                 Instr::Add(Slot::Out(1), vec![x, vx]),
             ],

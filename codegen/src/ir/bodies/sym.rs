@@ -7,9 +7,9 @@
 use std::fmt;
 
 use super::super::Rational;
-use super::super::expr::derivative::{Algebra, derivative};
 use super::super::expr::{Constant, Function, Node, NodeKind};
 use super::super::number::{checked_add, checked_mul, checked_pow};
+use crate::function::Algebra;
 use std::collections::HashMap;
 
 /// An expression under construction.
@@ -166,22 +166,13 @@ pub(super) fn square(a: Sym) -> Sym {
     pow(a, Rational { num: 2, den: 1 })
 }
 
-/// f(a).
+/// f(a), folded where a = 0 and f(0) is a whole number.
 pub(super) fn call(f: Function, a: Sym) -> Sym {
-    match (f, &a) {
-        (
-            Function::Sin
-            | Function::Tan
-            | Function::Sqrt
-            | Function::Atan
-            | Function::Asin
-            | Function::Sinh
-            | Function::Tanh,
-            Sym::Num(r),
-        ) if *r == ZERO => Sym::Num(ZERO),
-        (Function::Cos | Function::Exp | Function::Cosh, Sym::Num(r)) if *r == ZERO => {
-            Sym::Num(ONE)
-        }
+    match (f.at_zero(), &a) {
+        (Some(value), Sym::Num(r)) if *r == ZERO => Sym::Num(Rational {
+            num: i128::from(value),
+            den: 1,
+        }),
         _ => Sym::Call(f, Box::new(a)),
     }
 }
@@ -260,7 +251,7 @@ impl Sym {
                 }
                 let x = (**x).clone();
                 let y = call(*f, x.clone());
-                let mut factors = derivative(&mut Trees, *f, x, y);
+                let mut factors = f.derivative(&mut Trees, x, y);
                 factors.push(d);
                 mul(factors)
             }

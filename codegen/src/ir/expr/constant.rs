@@ -11,7 +11,8 @@
 
 use std::ops::Range;
 
-use super::{Function, Node, NodeKind};
+use super::{Node, NodeKind};
+use crate::function::Fold;
 
 /// A value and a bound on its absolute rounding error.
 #[derive(Clone, Copy, Debug)]
@@ -168,85 +169,14 @@ impl Node {
                 let Some(a) = x.approx()? else {
                     return Ok(None);
                 };
-                let name = f.name();
-                let (value, slope) = match f {
-                    Function::Sin => (a.value.sin(), 1.0),
-                    Function::Cos => (a.value.cos(), 1.0),
-                    Function::Tan => {
-                        let c = a.value.cos();
-                        if c.abs() <= a.error + EPS {
-                            return problem(format!(
-                                "tan({:.3e}), at a pole of tan (cos = {c:.3e} is 0 to within rounding)",
-                                a.value
-                            ));
-                        }
-                        (a.value.tan(), 1.0 / (c * c))
-                    }
-                    Function::Exp => {
-                        let v = a.value.exp();
-                        (v, v)
-                    }
-                    Function::Log | Function::Sqrt if a.value < -a.error => {
-                        return problem(format!(
-                            "{name} of a negative number ({:.3e}), which is not real",
-                            a.value
-                        ));
-                    }
-                    Function::Log => {
-                        if a.value <= a.error {
-                            return problem(format!(
-                                "log of 0 (to within rounding: {:.3e}), which is not finite",
-                                a.value
-                            ));
-                        }
-                        (a.value.ln(), 1.0 / a.value)
-                    }
-                    Function::Asin | Function::Acos if a.value.abs() > 1.0 + a.error => {
-                        return problem(format!(
-                            "{name} of {:.3e}, outside [-1, 1], which is not real",
-                            a.value
-                        ));
-                    }
-                    // At ±1 to within rounding the slope is unbounded: the
-                    // error is that of the square root it behaves as.
-                    Function::Asin | Function::Acos if a.value.abs() + a.error >= 1.0 => {
-                        let clamped = a.value.clamp(-1.0, 1.0);
-                        let v = if matches!(f, Function::Asin) {
-                            clamped.asin()
-                        } else {
-                            clamped.acos()
-                        };
-                        return Ok(Some(Approx {
-                            value: v,
-                            error: (2.0 * (a.error + EPS)).sqrt() * 2.0 + EPS * v.abs(),
-                        }));
-                    }
-                    Function::Asin => (a.value.asin(), 1.0 / (1.0 - a.value * a.value).sqrt()),
-                    Function::Acos => (a.value.acos(), 1.0 / (1.0 - a.value * a.value).sqrt()),
-                    Function::Atan => (a.value.atan(), 1.0),
-                    Function::Sinh | Function::Cosh => {
-                        let c = a.value.cosh();
-                        let v = if matches!(f, Function::Sinh) {
-                            a.value.sinh()
-                        } else {
-                            c
-                        };
-                        // |slope| ≤ cosh over the error's reach.
-                        (v, (a.value.abs() + a.error).cosh().max(c))
-                    }
-                    Function::Tanh => (a.value.tanh(), 1.0),
-                    Function::Sqrt if a.value <= a.error => (0.0, 0.0),
-                    Function::Sqrt => {
-                        let v = a.value.sqrt();
-                        (v, 0.5 / v)
-                    }
-                };
-                let error = if matches!(f, Function::Sqrt) && a.value <= a.error {
-                    a.error.sqrt()
-                } else {
-                    slope.abs() * a.error + EPS * value.abs()
-                };
-                Approx { value, error }
+                match f.fold(a.value, a.error) {
+                    Err(why) => return problem(why),
+                    Ok(Fold::Within { value, error }) => Approx { value, error },
+                    Ok(Fold::Slope { value, slope }) => Approx {
+                        value,
+                        error: slope.abs() * a.error + EPS * value.abs(),
+                    },
+                }
             }
         };
         if !out.value.is_finite() || !out.error.is_finite() {

@@ -1,14 +1,65 @@
-//! The series of the language's functions in the recurrences the
-//! transform has: sin and cos of one series as one pair, atan, asin and
-//! acos by [`Op::Arc`], sinh, cosh and tanh by exponentials.
+//! The transform's builder as the recurrences the language's series rules
+//! are written in (`function`): each operation one op of the transform,
+//! sin and cos of one series one pair.
 
 use super::{Builder, Op, Series, Summand, Term, constant};
-use crate::program::Func;
+use crate::function::{Function, Recurrences};
 
-impl Builder<'_> {
-    /// The sine (`sin`) or cosine of series `a`, both made at the first.
-    pub(super) fn sin_cos(&mut self, a: Series, sin: bool) -> Series {
-        let (s, c) = match self.trig.get(&a) {
+impl Recurrences for Builder<'_> {
+    type Series = Series;
+
+    fn sum(&mut self, series: &[Series], numbers: &[f64]) -> Series {
+        let mut terms: Vec<Term> = series.iter().map(|s| Term::Series(*s)).collect();
+        for x in numbers {
+            terms.push(Term::Number(constant(&mut self.numbers.consts, *x)));
+        }
+        as_series(self.sum(&terms))
+    }
+
+    fn difference(&mut self, a: Series, b: Series) -> Series {
+        self.op(|dst| Op::Add {
+            dst,
+            series: vec![
+                Summand {
+                    series: a,
+                    minus: false,
+                },
+                Summand {
+                    series: b,
+                    minus: true,
+                },
+            ],
+            numbers: Vec::new(),
+        })
+    }
+
+    fn product(&mut self, a: Series, b: Series) -> Series {
+        as_series(self.times(Term::Series(a), Term::Series(b)))
+    }
+
+    fn scale(&mut self, a: Series, x: f64) -> Series {
+        let x = Term::Number(constant(&mut self.numbers.consts, x));
+        as_series(self.times(Term::Series(a), x))
+    }
+
+    fn recip(&mut self, a: Series) -> Series {
+        self.op(|dst| Op::Recip { dst, a })
+    }
+
+    fn sqrt(&mut self, a: Series) -> Series {
+        self.op(|dst| Op::Sqrt { dst, a })
+    }
+
+    fn exp(&mut self, a: Series) -> Series {
+        self.op(|dst| Op::Exp { dst, a })
+    }
+
+    fn log(&mut self, a: Series) -> Series {
+        self.op(|dst| Op::Log { dst, a })
+    }
+
+    fn sin_cos(&mut self, a: Series) -> (Series, Series) {
+        match self.trig.get(&a) {
             Some(pair) => *pair,
             None => {
                 let (sin, cos) = (self.temp(), self.temp());
@@ -16,72 +67,63 @@ impl Builder<'_> {
                 self.trig.insert(a, (sin, cos));
                 (sin, cos)
             }
-        };
-        if sin { s } else { c }
+        }
     }
 
-    /// atan, asin or acos of series `a` ([`Op::Arc`]).
-    pub(super) fn arc(&mut self, a: Series, f: Func) -> Series {
-        let one = Term::Number(constant(&mut self.numbers.consts, 1.0));
-        let square = self.times(Term::Series(a), Term::Series(a));
-        let w = if f == Func::Atan {
-            self.sum(&[one, square])
-        } else {
-            let minus_one = Term::Number(constant(&mut self.numbers.consts, -1.0));
-            let negated = self.times(square, minus_one);
-            let Term::Series(rest) = self.sum(&[one, negated]) else {
-                unreachable!("a sum with a series is a series")
-            };
-            Term::Series(self.op(|dst| Op::Sqrt { dst, a: rest }))
-        };
-        let Term::Series(w) = w else {
-            unreachable!("a sum with a series is a series")
-        };
+    fn arc(&mut self, f: Function, a: Series, w: Series, minus: bool) -> Series {
         self.op(|dst| Op::Arc {
             dst,
             a,
             w,
             f,
-            minus: f == Func::Acos,
+            minus,
         })
     }
+}
 
-    /// sinh, cosh or tanh of series `a`, in exponentials: (eᵃ ∓ 1/eᵃ)/2,
-    /// and tanh a = 1 − 2/(e²ᵃ + 1), which stays finite where eᵃ does not.
-    pub(super) fn hyperbolic(&mut self, a: Series, f: Func) -> Term {
-        let number = |b: &mut Self, x: f64| Term::Number(constant(&mut b.numbers.consts, x));
-        if f == Func::Tanh {
-            let two = number(self, 2.0);
-            let Term::Series(twice) = self.times(Term::Series(a), two) else {
-                unreachable!("a series times a number is a series")
+/// A term the builder made from a series.
+fn as_series(t: Term) -> Series {
+    match t {
+        Term::Series(s) => s,
+        Term::Number(_) | Term::Negated(_) => unreachable!("an operation on a series is a series"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::along_a_line;
+    use crate::function::Function;
+    use crate::program::{Instr, Program, Slot};
+
+    /// Every function of the language, through its own series rule: the
+    /// transform of f(x) along x(t) = x₀ + t/2 against f's values (the
+    /// libm function emitted code calls) at a few points of t.
+    #[test]
+    fn every_function_along_a_line() {
+        for f in Function::ALL {
+            let x = Slot::Input(1);
+            let p = Program {
+                inputs: 2,
+                consts: vec![],
+                instrs: vec![Instr::Fun(Slot::Out(0), f, x)],
+                outputs: 1,
             };
-            let e = self.op(|dst| Op::Exp { dst, a: twice });
-            let one = number(self, 1.0);
-            let Term::Series(d) = self.sum(&[Term::Series(e), one]) else {
-                unreachable!("a sum with a series is a series")
+            let x0 = if matches!(f, Function::Log | Function::Sqrt) {
+                1.5
+            } else {
+                0.3
             };
-            let r = self.op(|dst| Op::Recip { dst, a: d });
-            let minus_two = number(self, -2.0);
-            let scaled = self.times(Term::Series(r), minus_two);
-            return self.sum(&[one, scaled]);
+            let c = along_a_line(&p, x0, 0.5, 30);
+            for tau in [0.0, 0.1, -0.2, 0.3] {
+                let got = dalembert_runtime::taylor::eval(&c, 30, tau);
+                let want = f.value(x0 + 0.5 * tau);
+                assert!(
+                    (got - want).abs() <= 1e-13 * want.abs().max(1.0),
+                    "{}({}): {got} {want}",
+                    f.name(),
+                    x0 + 0.5 * tau
+                );
+            }
         }
-        let e = self.op(|dst| Op::Exp { dst, a });
-        let r = self.op(|dst| Op::Recip { dst, a: e });
-        let both = self.op(|dst| Op::Add {
-            dst,
-            series: vec![
-                Summand {
-                    series: e,
-                    minus: false,
-                },
-                Summand {
-                    series: r,
-                    minus: f == Func::Sinh,
-                },
-            ],
-            numbers: Vec::new(),
-        });
-        let half = number(self, 0.5);
-        self.times(Term::Series(both), half)
     }
 }

@@ -17,7 +17,8 @@ use std::collections::{HashMap, HashSet};
 use dalembert_runtime::taylor::Work;
 
 use super::machine::{Machine, lower};
-use super::{Func, Instr, Program, Slot, constant};
+use super::{Instr, Program, Slot, constant};
+use crate::function::{Function, Recurrences};
 
 mod evaluate;
 mod functions;
@@ -96,7 +97,7 @@ pub enum Op {
         dst: Series,
         a: Series,
         w: Series,
-        f: Func,
+        f: Function,
         minus: bool,
     },
 }
@@ -287,21 +288,13 @@ impl<'a> Builder<'a> {
                         let root = self.op(|dst| Op::Sqrt { dst, a });
                         over(self, reciprocal, root)
                     }
-                    Machine::Call(Func::Exp, _) => Term::Series(self.op(|dst| Op::Exp { dst, a })),
-                    Machine::Call(Func::Log, _) => Term::Series(self.op(|dst| Op::Log { dst, a })),
+                    // The function's own rule (`function`).
+                    Machine::Call(f, _) => Term::Series(f.series(self, a)),
                     // sin and cos of one series share one pair of series,
                     // whichever slots they came through.
-                    Machine::Call(f @ (Func::Sin | Func::Cos), _) => {
-                        Term::Series(self.sin_cos(a, f == Func::Sin))
-                    }
-                    Machine::Call(f @ (Func::Atan | Func::Asin | Func::Acos), _) => {
-                        Term::Series(self.arc(a, f))
-                    }
-                    Machine::Call(f @ (Func::Sinh | Func::Cosh | Func::Tanh), _) => {
-                        self.hyperbolic(a, f)
-                    }
                     Machine::SinCos { sin, .. } | Machine::Half { sin, .. } => {
-                        Term::Series(self.sin_cos(a, sin))
+                        let (s, c) = self.sin_cos(a);
+                        Term::Series(if sin { s } else { c })
                     }
                     _ => unreachable!("{m:?} is not the machine form of a power or function"),
                 }
@@ -540,7 +533,7 @@ mod tests {
             consts: vec![-1.0],
             instrs: vec![
                 Instr::Pow(Slot::Temp(0), l, -1),
-                Instr::Fun(Slot::Temp(1), Func::Sin, q),
+                Instr::Fun(Slot::Temp(1), Function::Sin, q),
                 Instr::Mul(
                     Slot::Out(0),
                     vec![Slot::Const(0), g, Slot::Temp(0), Slot::Temp(1)],
@@ -574,6 +567,27 @@ mod tests {
         }
     }
 
+    /// The series of output 0 of `p` (inputs: one parameter, unused, then
+    /// a coordinate x) along x(t) = `x0` + `slope`·t, to `order`.
+    pub(super) fn along_a_line(
+        p: &Program,
+        x0: f64,
+        slope: f64,
+        order: usize,
+    ) -> dalembert_runtime::taylor::Coefficients {
+        let tr = p.taylor(1, 1);
+        let mut e = Evaluation {
+            q: vec![[0.0; tay::CAPACITY]],
+            v: vec![],
+            temps: vec![],
+            ..Evaluation::default()
+        };
+        e.q[0][0] = x0;
+        e.q[0][1] = slope;
+        let numbers = tr.number_values(&[0.0], |p, x| p.eval(x));
+        tr.along(&numbers, &mut e, order)
+    }
+
     /// Every kind of instruction: the transform of
     /// o = exp(x)·log(x)·x^-2 + sqrt(x) + x^1.5 + x^10 + 1/sqrt(x) − cos(x)
     /// along x(t) = 2 + t agrees with its values at a few points of t.
@@ -585,15 +599,15 @@ mod tests {
             inputs: 2,
             consts: vec![],
             instrs: vec![
-                Instr::Fun(t(0), Func::Exp, x),
-                Instr::Fun(t(1), Func::Log, x),
+                Instr::Fun(t(0), Function::Exp, x),
+                Instr::Fun(t(1), Function::Log, x),
                 Instr::Pow(t(2), x, -2),
                 Instr::Mul(t(3), vec![t(0), t(1), t(2)]),
-                Instr::Fun(t(4), Func::Sqrt, x),
+                Instr::Fun(t(4), Function::Sqrt, x),
                 Instr::Powf(t(5), x, 1.5),
                 Instr::Pow(t(6), x, 10),
                 Instr::Powf(t(7), x, -0.5),
-                Instr::Fun(t(8), Func::Cos, x),
+                Instr::Fun(t(8), Function::Cos, x),
                 Instr::Add(t(9), vec![t(3), t(4), t(5), t(6), t(7)]),
                 Instr::Sub(Slot::Out(0), [t(9), t(8)]),
             ],
@@ -603,18 +617,7 @@ mod tests {
             x.exp() * x.ln() / (x * x) + x.sqrt() + x.powf(1.5) + x.powi(10) + 1.0 / x.sqrt()
                 - x.cos()
         };
-        // inputs: one parameter (unused), then the coordinate x.
-        let tr = p.taylor(1, 1);
-        let mut e = Evaluation {
-            q: vec![[0.0; tay::CAPACITY]],
-            v: vec![],
-            temps: vec![],
-            ..Evaluation::default()
-        };
-        e.q[0][0] = 2.0;
-        e.q[0][1] = 1.0;
-        let numbers = tr.number_values(&[0.0], |p, x| p.eval(x));
-        let c = tr.along(&numbers, &mut e, 30);
+        let c = along_a_line(&p, 2.0, 1.0, 30);
         for tau in [0.0, 0.1, -0.2, 0.3] {
             let got = dalembert_runtime::taylor::eval(&c, 30, tau);
             let want = f(2.0 + tau);

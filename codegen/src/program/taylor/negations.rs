@@ -151,7 +151,7 @@ pub(super) fn fold(ops: Vec<Op>, outputs: &mut [Term], consts: &[f64], minus_one
 mod tests {
     use super::super::Evaluation;
     use super::*;
-    use crate::program::{Func, Instr, Program};
+    use crate::program::{Function, Instr, Program};
     use dalembert_runtime::__private::taylor as tay;
 
     /// x₁ − x₁·sin x₀ and −(x₀·x₁)·cos x₀, the shapes of the Euler-angle
@@ -166,10 +166,10 @@ mod tests {
             inputs: 2,
             consts: vec![-1.0],
             instrs: vec![
-                Instr::Fun(Slot::Temp(0), Func::Sin, x0),
+                Instr::Fun(Slot::Temp(0), Function::Sin, x0),
                 Instr::Mul(Slot::Temp(1), vec![x1, Slot::Temp(0)]),
                 Instr::Sub(Slot::Out(0), [x1, Slot::Temp(1)]),
-                Instr::Fun(Slot::Temp(2), Func::Cos, x0),
+                Instr::Fun(Slot::Temp(2), Function::Cos, x0),
                 Instr::Mul(Slot::Temp(3), vec![minus_one, x0, x1]),
                 Instr::Mul(Slot::Out(1), vec![Slot::Temp(3), Slot::Temp(2)]),
             ],

@@ -84,7 +84,7 @@ impl Op {
 mod tests {
     use super::super::Evaluation;
     use super::*;
-    use crate::program::{Func, Instr, Program, Slot};
+    use crate::program::{Function, Instr, Program, Slot};
     use dalembert_runtime::__private::taylor as tay;
 
     /// A product with a reciprocal is one quotient: sin(x)·x⁻¹ is a sin/cos
@@ -97,7 +97,7 @@ mod tests {
             inputs: 1,
             consts: vec![],
             instrs: vec![
-                Instr::Fun(Slot::Temp(0), Func::Sin, x),
+                Instr::Fun(Slot::Temp(0), Function::Sin, x),
                 Instr::Pow(Slot::Temp(1), x, -1),
                 Instr::Mul(Slot::Out(0), vec![Slot::Temp(1), Slot::Temp(0)]),
             ],

@@ -183,7 +183,7 @@ impl Solve {
 #[cfg(test)]
 #[allow(clippy::needless_range_loop)] // matrices by index, as written on paper
 mod tests {
-    use crate::program::{Func, Instr, Layout, Program, Slot, Transform};
+    use crate::program::{Function, Instr, Layout, Program, Slot, Transform};
 
     /// (q₀, q₁, v₀, v₁).
     const INPUTS: [Slot; 4] = [
@@ -201,8 +201,8 @@ mod tests {
         let (three, two) = (Slot::Const(0), Slot::Const(1));
         vec![
             Instr::Sub(t(0), [q0, q1]),
-            Instr::Fun(t(1), Func::Cos, t(0)),
-            Instr::Fun(t(2), Func::Sin, t(0)),
+            Instr::Fun(t(1), Function::Cos, t(0)),
+            Instr::Fun(t(2), Function::Sin, t(0)),
             Instr::Assign(Slot::Out(0), three),
             Instr::Assign(Slot::Out(1), t(1)),
             Instr::Assign(Slot::Out(2), two),
@@ -234,13 +234,13 @@ mod tests {
         let mut instrs = g_part();
         instrs.extend([
             Instr::Pow(t(3), v1, 2),
-            Instr::Fun(t(4), Func::Sin, q0),
+            Instr::Fun(t(4), Function::Sin, q0),
             Instr::Mul(t(5), vec![two, t(4)]),
             Instr::Mul(t(6), vec![t(2), t(3)]),
             Instr::Add(Slot::Out(3), vec![t(6), t(5)]),
             Instr::Pow(t(7), v0, 2),
             Instr::Mul(t(8), vec![minus_one, t(2), t(7)]),
-            Instr::Fun(t(9), Func::Sin, q1),
+            Instr::Fun(t(9), Function::Sin, q1),
             Instr::Add(Slot::Out(4), vec![t(8), t(9)]),
         ]);
         let program = Program {
@@ -305,11 +305,11 @@ mod tests {
         let mut instrs = g_part();
         instrs.extend([
             Instr::Mul(t(3), vec![t(2), v0, v1]),
-            Instr::Fun(t(4), Func::Sin, q0),
+            Instr::Fun(t(4), Function::Sin, q0),
             Instr::Mul(t(5), vec![minus_two, t(4)]),
             Instr::Mul(t(6), vec![minus_one, t(3)]),
             Instr::Add(Slot::Out(3), vec![t(6), t(5)]),
-            Instr::Fun(t(7), Func::Sin, q1),
+            Instr::Fun(t(7), Function::Sin, q1),
             Instr::Mul(t(8), vec![minus_one, t(7)]),
             Instr::Add(Slot::Out(4), vec![t(3), t(8)]),
         ]);

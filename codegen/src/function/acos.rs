@@ -1,0 +1,28 @@
+//! acos: −1/√(1 − x²) is its derivative; its series is that integrated
+//! ([`Recurrences::arc`] with w = √(1 − a²), signed).
+
+use super::{Algebra, Fold, Function, Recurrences, Rules, arc, arc_fold, one_minus};
+use dalembert_runtime::{interval::Interval, libm};
+
+pub(super) struct Acos;
+
+impl Rules for Acos {
+    const NAME: &'static str = "acos";
+    const AT_ZERO: Option<i64> = None;
+    fn value(x: f64) -> f64 {
+        libm::acos(x)
+    }
+    fn interval(x: Interval) -> Interval {
+        x.acos()
+    }
+    fn fold(x: f64, error: f64) -> Result<Fold, String> {
+        arc_fold(Self::NAME, libm::acos, x, error)
+    }
+    fn derivative<A: Algebra>(a: &mut A, x: A::E, _: A::E) -> Vec<A::E> {
+        let w = one_minus(a, x);
+        vec![a.number(-1, 1), a.pow(w, -1, 2)]
+    }
+    fn series<R: Recurrences>(r: &mut R, a: R::Series) -> R::Series {
+        arc(r, Function::Acos, a)
+    }
+}

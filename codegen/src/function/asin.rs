@@ -1,0 +1,28 @@
+//! asin: 1/√(1 − x²) is its derivative; its series is that integrated
+//! ([`Recurrences::arc`] with w = √(1 − a²)).
+
+use super::{Algebra, Fold, Function, Recurrences, Rules, arc, arc_fold, one_minus};
+use dalembert_runtime::{interval::Interval, libm};
+
+pub(super) struct Asin;
+
+impl Rules for Asin {
+    const NAME: &'static str = "asin";
+    const AT_ZERO: Option<i64> = Some(0);
+    fn value(x: f64) -> f64 {
+        libm::asin(x)
+    }
+    fn interval(x: Interval) -> Interval {
+        x.asin()
+    }
+    fn fold(x: f64, error: f64) -> Result<Fold, String> {
+        arc_fold(Self::NAME, libm::asin, x, error)
+    }
+    fn derivative<A: Algebra>(a: &mut A, x: A::E, _: A::E) -> Vec<A::E> {
+        let w = one_minus(a, x);
+        vec![a.pow(w, -1, 2)]
+    }
+    fn series<R: Recurrences>(r: &mut R, a: R::Series) -> R::Series {
+        arc(r, Function::Asin, a)
+    }
+}

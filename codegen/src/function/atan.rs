@@ -1,0 +1,28 @@
+//! atan: 1/(1 + x²) is its derivative; its series is that integrated
+//! ([`Recurrences::arc`] with w = 1 + a²).
+
+use super::{Algebra, Fold, Function, Recurrences, Rules, arc, one_plus, sloped};
+use dalembert_runtime::{interval::Interval, libm};
+
+pub(super) struct Atan;
+
+impl Rules for Atan {
+    const NAME: &'static str = "atan";
+    const AT_ZERO: Option<i64> = Some(0);
+    fn value(x: f64) -> f64 {
+        libm::atan(x)
+    }
+    fn interval(x: Interval) -> Interval {
+        x.atan()
+    }
+    fn fold(x: f64, _: f64) -> Result<Fold, String> {
+        sloped(libm::atan(x), 1.0)
+    }
+    fn derivative<A: Algebra>(a: &mut A, x: A::E, _: A::E) -> Vec<A::E> {
+        let w = one_plus(a, x);
+        vec![a.pow(w, -1, 1)]
+    }
+    fn series<R: Recurrences>(r: &mut R, a: R::Series) -> R::Series {
+        arc(r, Function::Atan, a)
+    }
+}

@@ -1,0 +1,27 @@
+//! sin: cos is its derivative, and sin and cos of one series are one pair
+//! of series.
+
+use super::{Algebra, Fold, Function, Recurrences, Rules, sloped};
+use dalembert_runtime::{interval::Interval, libm};
+
+pub(super) struct Sin;
+
+impl Rules for Sin {
+    const NAME: &'static str = "sin";
+    const AT_ZERO: Option<i64> = Some(0);
+    fn value(x: f64) -> f64 {
+        libm::sin(x)
+    }
+    fn interval(x: Interval) -> Interval {
+        x.sin()
+    }
+    fn fold(x: f64, _: f64) -> Result<Fold, String> {
+        sloped(libm::sin(x), 1.0)
+    }
+    fn derivative<A: Algebra>(a: &mut A, x: A::E, _: A::E) -> Vec<A::E> {
+        vec![a.call(Function::Cos, x)]
+    }
+    fn series<R: Recurrences>(r: &mut R, a: R::Series) -> R::Series {
+        r.sin_cos(a).0
+    }
+}
