@@ -511,12 +511,12 @@ names = ["x", "y"]
 
 [dynamics]
 kinetic_energy = "m/2*cosh(y/2)*x_dot^2 + (1 + atan(x)^2)/2*y_dot^2"
-potential = "sinh(x/3)*tanh(y) + asin(x/4) - acos(y/5)"
+potential = "sinh(x/3)*tanh(y) + asin(x/4) - acos(y/5) + asinh(x/2)*atanh(y/3)"
 constraints = ["tanh(x)*x_dot + cosh(y)*y_dot"]
 
 [[wall]]
 name = "rim"
-surface = "2 - atan(x)^2 - sinh(y)^2 + asin(x/5)*acos(y/5)"
+surface = "2 - atan(x)^2 - sinh(y)^2 + asin(x/5)*acos(y/5) + acosh(2 + x*y)/10"
 "#;
 
 /// [`ARCS`] without its constraint: q̈ in closed form, so the model has
@@ -535,10 +535,14 @@ fn arc_and_hyperbolic_functions_reach_the_emitted_programs() {
     let t = |q: &[f64], v: &[f64]| {
         (q[1] / 2.0).cosh() * v[0] * v[0] + (1.0 + q[0].atan().powi(2)) / 2.0 * v[1] * v[1]
     };
-    let potential =
-        |q: &[f64]| (q[0] / 3.0).sinh() * q[1].tanh() + (q[0] / 4.0).asin() - (q[1] / 5.0).acos();
+    let potential = |q: &[f64]| {
+        (q[0] / 3.0).sinh() * q[1].tanh() + (q[0] / 4.0).asin() - (q[1] / 5.0).acos()
+            + (q[0] / 2.0).asinh() * (q[1] / 3.0).atanh()
+    };
     let rim = |q: &[f64]| {
-        2.0 - q[0].atan().powi(2) - q[1].sinh().powi(2) + (q[0] / 5.0).asin() * (q[1] / 5.0).acos()
+        2.0 - q[0].atan().powi(2) - q[1].sinh().powi(2)
+            + (q[0] / 5.0).asin() * (q[1] / 5.0).acos()
+            + (2.0 + q[0] * q[1]).acosh() / 10.0
     };
     let d = derive("arcs", ARCS);
     let mut seed = 11u64;
@@ -555,7 +559,9 @@ fn arc_and_hyperbolic_functions_reach_the_emitted_programs() {
     let f32_code = with_model_file("arcs", ARCS, |path| {
         dalembert_codegen::generate_f32(path).unwrap()
     });
-    for f in ["atanf", "asinf", "acosf", "sinhf", "coshf", "tanhf"] {
+    for f in [
+        "atanf", "asinf", "acosf", "sinhf", "coshf", "tanhf", "asinhf", "acoshf", "atanhf",
+    ] {
         assert!(f32_code.contains(f), "{f} in the f32 programs");
     }
 }

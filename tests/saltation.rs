@@ -110,6 +110,9 @@ fn saltation_matches_differences_of_the_flow_through_a_collision() {
         ("disk_sinh", 1.0),
         ("disk_cosh", 1.0),
         ("disk_tanh", 1.0),
+        ("disk_asinh", 1.0),
+        ("disk_acosh", 1.0),
+        ("disk_atanh", 1.0),
     ] {
         let m = model(name);
         let wall = m.walls()[0];

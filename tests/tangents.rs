@@ -438,6 +438,9 @@ fn interpreted_models_with_nonpolynomial_walls() {
         "disk_sinh",
         "disk_cosh",
         "disk_tanh",
+        "disk_asinh",
+        "disk_acosh",
+        "disk_atanh",
         "disk_functions",
     ] {
         run::<2>(name);

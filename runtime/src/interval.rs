@@ -219,6 +219,27 @@ impl Interval {
         self.monotone(libm::tanh, true).within(-1.0, 1.0)
     }
 
+    /// The inverse hyperbolic sine.
+    pub fn asinh(self) -> Self {
+        self.monotone(libm::asinh, true)
+    }
+
+    /// The inverse hyperbolic cosine (undefined below 1).
+    pub fn acosh(self) -> Self {
+        if self.lo < 1.0 || self.lo.is_nan() {
+            return Self::ENTIRE;
+        }
+        self.monotone(libm::acosh, true).within(0.0, f64::INFINITY)
+    }
+
+    /// The inverse hyperbolic tangent (undefined outside (−1, 1)).
+    pub fn atanh(self) -> Self {
+        if self.lo.is_nan() || self.hi.is_nan() || self.lo <= -1.0 || self.hi >= 1.0 {
+            return Self::ENTIRE;
+        }
+        self.monotone(libm::atanh, true)
+    }
+
     /// The sine.
     pub fn sin(self) -> Self {
         // Extremes at (m + ½)π: +1 for even m, −1 for odd.

@@ -17,12 +17,23 @@
 //! test decides. The point puts each symbol in [1/4, 3/4], from a hash of
 //! its name (the same point every run), where square roots and logarithms
 //! of the symbols themselves are real.
+//!
+//! symbolica's evaluation does not know the functions of ours (atan, asin,
+//! acos and the hyperbolic ones): each application of one is valued first,
+//! innermost first, from its argument's value at the same precision
+//! ([`own_value`]), and the expression is then evaluated with those values
+//! given. Without them every expression with such a function went to the
+//! exact test, whose expansion had no bound (a wall with atan, sinh, asin
+//! and acos in it and a term x·y: its P's derivatives past 2 GB in a
+//! second).
 
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 
 use symbolica::prelude::*;
 
 use super::atoms::children;
+use super::build::own_functions;
+use crate::function::Function;
 
 /// The two precisions, in bits.
 const LOW: u32 = 128;
@@ -32,11 +43,19 @@ const HIGH: u32 = 256;
 pub fn nonzero(a: &Atom) -> bool {
     let mut symbols = HashSet::new();
     collect(a.as_view(), &mut symbols);
+    let ours: Vec<Symbol> = own_functions().collect();
+    let mut applied = Vec::new();
+    applications(a.as_view(), &ours, &mut applied);
     let value = |prec: u32| {
-        let map: std::collections::HashMap<Atom, Float> = symbols
+        let mut map: HashMap<Atom, Float> = symbols
             .iter()
             .map(|s| (Atom::from(*s), Float::with_val(prec, coordinate(*s))))
             .collect();
+        for (app, f) in &applied {
+            let z = argument(app).evaluate_with_prec(&map, prec).ok()?;
+            let y = own_value(*f, z, prec)?;
+            map.insert(app.clone(), y);
+        }
         a.evaluate_with_prec(&map, prec).ok()
     };
     let (Some(low), Some(high)) = (value(LOW), value(HIGH)) else {
@@ -45,6 +64,83 @@ pub fn nonzero(a: &Atom) -> bool {
     let (low, high) = (low.to_f64(), high.to_f64());
     // Agreement to 2⁻⁶⁴ shows in f64 as agreement to its last bits.
     high.is_finite() && high != 0.0 && (low - high).abs() <= 4.0 * f64::EPSILON * high.abs()
+}
+
+/// The applications of the functions `ours` in `a`, each once, every one
+/// after those inside its argument.
+fn applications(a: AtomView, ours: &[Symbol], out: &mut Vec<(Atom, Function)>) {
+    for x in children(a) {
+        applications(x, ours, out);
+    }
+    if let AtomView::Fun(f) = a
+        && ours.contains(&f.get_symbol())
+        && let Some(function) = Function::from_name(f.get_symbol().get_stripped_name())
+        && !out.iter().any(|(b, _)| b.as_view() == a)
+    {
+        out.push((a.to_owned(), function));
+    }
+}
+
+/// The one argument of an application.
+fn argument(app: &Atom) -> Atom {
+    match app.as_view() {
+        AtomView::Fun(f) => f.iter().next().expect("one argument").to_owned(),
+        _ => unreachable!("an application"),
+    }
+}
+
+/// f(`z`) at precision `prec` for a function of ours: the hyperbolic ones
+/// and their inverses by exponentials and logarithms, which symbolica
+/// evaluates; atan, asin and acos by Newton's method on tan, sin and cos
+/// from libm's value, and only where the last step is below 2⁻⁽ᵖʳᵉᶜ⁻⁸⁾ of
+/// the result (else `None`: a value off in the same bits at both
+/// precisions could make a zero look like none).
+fn own_value(f: Function, z: Float, prec: u32) -> Option<Float> {
+    let (y, x) = (
+        Atom::from(symbol!("dalembert_probe::y")),
+        Atom::from(symbol!("dalembert_probe::z")),
+    );
+    let (one, two, half) = (Atom::num(1), Atom::num(2), Atom::num(1) / Atom::num(2));
+    let exp = |a: Atom| function!(Symbol::EXP, a);
+    let log = |a: Atom| function!(Symbol::LOG, a);
+    let (sin, cos) = (
+        function!(Symbol::SIN, y.clone()),
+        function!(Symbol::COS, y.clone()),
+    );
+    let closed = match f {
+        Function::Sinh => Some((exp(x.clone()) - exp(-x.clone())) / &two),
+        Function::Cosh => Some((exp(x.clone()) + exp(-x.clone())) / &two),
+        Function::Tanh => Some(&one - &two / (exp(&two * &x) + &one)),
+        Function::Asinh => Some(log(&x + (x.pow(&two) + &one).pow(&half))),
+        Function::Acosh => Some(log(&x + (x.pow(&two) - &one).pow(&half))),
+        Function::Atanh => Some(log((&one + &x) / (&one - &x)) / &two),
+        _ => None,
+    };
+    let at = |e: &Atom, y_value: Option<&Float>| {
+        let mut map = HashMap::from([(x.clone(), z.clone())]);
+        if let Some(v) = y_value {
+            map.insert(y.clone(), v.clone());
+        }
+        e.evaluate_with_prec(&map, prec).ok()
+    };
+    if let Some(e) = closed {
+        return at(&e, None).filter(|v| v.to_f64().is_finite());
+    }
+    // Newton's step g/g′ for g(y) = 0 at y = f(z).
+    let step = match f {
+        Function::Atan => (&sin - &x * &cos) / (&cos + &x * &sin),
+        Function::Asin => (&sin - &x) / &cos,
+        Function::Acos => -(&cos - &x) / &sin,
+        _ => return None,
+    };
+    let mut value = Float::with_val(prec, f.value(z.to_f64()));
+    let next = &y - &step;
+    for _ in 0..6 {
+        value = at(&next, Some(&value))?;
+    }
+    let last = at(&step, Some(&value))?.to_f64();
+    let size = value.to_f64();
+    (last.abs() <= size.abs() * 2f64.powi(8 - prec as i32) && size.is_finite()).then_some(value)
 }
 
 /// The symbols `a` reads as variables (not the functions it applies).
@@ -117,6 +213,55 @@ mod tests {
         let cancelled = &zeros[0] + &tiny;
         for a in [undefined, cancelled] {
             assert!(!nonzero(&a), "{a}");
+        }
+    }
+
+    /// The functions of ours are valued at both precisions, so their
+    /// identities are zero to rounding (never "not zero": each value is
+    /// right to its precision) and other expressions in them are settled
+    /// without the exact test.
+    #[test]
+    fn functions_of_ours_are_valued() {
+        crate::lock::acquire().unwrap();
+        let _ns = Namespace::enter("probe test, ours");
+        let [x, y, z] = ["x", "y", "z"].map(|n| Atom::from(own_symbol(n)));
+        let ours = |f: Function, a: &Atom| function!(own_symbol(f.name()), a);
+        let (sin, cos) = (
+            |a: &Atom| function!(Symbol::SIN, a),
+            |a: &Atom| function!(Symbol::COS, a),
+        );
+        let one = Atom::num(1);
+        let half = Atom::num(1) / Atom::num(2);
+        let identities = [
+            // tan(atan x) = x, sin(asin y) = y, cos(acos z) = z.
+            sin(&ours(Function::Atan, &x)) / cos(&ours(Function::Atan, &x)) - &x,
+            sin(&ours(Function::Asin, &y)) - &y,
+            cos(&ours(Function::Acos, &z)) - &z,
+            // cosh² − sinh² = 1, and each inverse undoes its function.
+            ours(Function::Cosh, &x).pow(Atom::num(2))
+                - ours(Function::Sinh, &x).pow(Atom::num(2))
+                - &one,
+            ours(Function::Asinh, &ours(Function::Sinh, &y)) - &y,
+            ours(Function::Acosh, &ours(Function::Cosh, &z)) - &z,
+            ours(Function::Atanh, &ours(Function::Tanh, &x)) - &x,
+            // atan inside asin: asin(x/√(1 + x²)) = atan x.
+            ours(
+                Function::Asin,
+                &(&x / (&one + x.pow(Atom::num(2))).pow(half.clone())),
+            ) - ours(Function::Atan, &x),
+        ];
+        for a in &identities {
+            assert!(!nonzero(a), "{a}");
+        }
+        let not_zeros = [
+            ours(Function::Atan, &x) - ours(Function::Asin, &y),
+            ours(Function::Acos, &z) * &x - &y,
+            ours(Function::Sinh, &ours(Function::Atan, &x)) - &z,
+            ours(Function::Acosh, &(&one + &x)) + ours(Function::Atanh, &y) * &z,
+            ours(Function::Tanh, &x) - ours(Function::Asinh, &y),
+        ];
+        for a in &not_zeros {
+            assert!(nonzero(a), "{a}");
         }
     }
 }

@@ -1,7 +1,7 @@
 //! acos: −1/√(1 − x²) is its derivative; its series is that integrated
 //! ([`Recurrences::arc`] with w = √(1 − a²), signed).
 
-use super::{Algebra, Fold, Function, Recurrences, Rules, arc, arc_fold, one_minus};
+use super::{Algebra, Fold, Function, Recurrences, Rules, arc_fold, one_minus, one_plus_square};
 use dalembert_runtime::{interval::Interval, libm};
 
 pub(super) struct Acos;
@@ -23,6 +23,8 @@ impl Rules for Acos {
         vec![a.number(-1, 1), a.pow(w, -1, 2)]
     }
     fn series<R: Recurrences>(r: &mut R, a: R::Series) -> R::Series {
-        arc(r, Function::Acos, a)
+        let rest = one_plus_square(r, a, -1.0);
+        let w = r.sqrt(rest);
+        r.arc(Function::Acos, a, w, true)
     }
 }

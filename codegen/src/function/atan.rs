@@ -1,7 +1,7 @@
 //! atan: 1/(1 + x²) is its derivative; its series is that integrated
 //! ([`Recurrences::arc`] with w = 1 + a²).
 
-use super::{Algebra, Fold, Function, Recurrences, Rules, arc, one_plus, sloped};
+use super::{Algebra, Fold, Function, Recurrences, Rules, one_plus, one_plus_square, sloped};
 use dalembert_runtime::{interval::Interval, libm};
 
 pub(super) struct Atan;
@@ -23,6 +23,7 @@ impl Rules for Atan {
         vec![a.pow(w, -1, 1)]
     }
     fn series<R: Recurrences>(r: &mut R, a: R::Series) -> R::Series {
-        arc(r, Function::Atan, a)
+        let w = one_plus_square(r, a, 1.0);
+        r.arc(Function::Atan, a, w, false)
     }
 }

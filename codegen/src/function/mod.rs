@@ -16,8 +16,11 @@
 //! ours.
 
 mod acos;
+mod acosh;
 mod asin;
+mod asinh;
 mod atan;
+mod atanh;
 mod cos;
 mod cosh;
 mod exp;
@@ -216,6 +219,12 @@ functions! {
     Cosh => cosh::Cosh,
     /// hyperbolic tangent
     Tanh => tanh::Tanh,
+    /// inverse hyperbolic sine
+    Asinh => asinh::Asinh,
+    /// inverse hyperbolic cosine
+    Acosh => acosh::Acosh,
+    /// inverse hyperbolic tangent
+    Atanh => atanh::Atanh,
 }
 
 impl Function {
@@ -261,18 +270,11 @@ fn not_real(name: &str, x: f64) -> Result<Fold, String> {
     ))
 }
 
-/// The series of atan, asin and acos of `a`: `c′ = ±a′/w` with w = 1 + a²
-/// for atan, √(1 − a²) for the others.
-fn arc<R: Recurrences>(r: &mut R, f: Function, a: R::Series) -> R::Series {
+/// The series 1 + s·a² of `a` (`s` = ±1).
+fn one_plus_square<R: Recurrences>(r: &mut R, a: R::Series, s: f64) -> R::Series {
     let square = r.product(a, a);
-    let w = if f == Function::Atan {
-        r.sum(&[square], &[1.0])
-    } else {
-        let negated = r.scale(square, -1.0);
-        let rest = r.sum(&[negated], &[1.0]);
-        r.sqrt(rest)
-    };
-    r.arc(f, a, w, f == Function::Acos)
+    let signed = if s == 1.0 { square } else { r.scale(square, s) };
+    r.sum(&[signed], &[1.0])
 }
 
 /// The fold of asin or acos (`f`, named `name`) at `x` within `error`:
@@ -348,10 +350,10 @@ mod tests {
 
     /// Points inside every function's domain.
     fn points(f: Function) -> [f64; 4] {
-        let shift = if matches!(f, Function::Log | Function::Sqrt) {
-            1.0
-        } else {
-            0.0
+        let shift = match f {
+            Function::Log | Function::Sqrt => 1.0,
+            Function::Acosh => 2.0,
+            _ => 0.0,
         };
         [-0.7, -0.2, 0.3, 0.9].map(|x| x + shift)
     }

@@ -108,7 +108,7 @@ mod tests {
                 instrs: vec![Instr::Fun(Slot::Out(0), f, x)],
                 outputs: 1,
             };
-            let x0 = if matches!(f, Function::Log | Function::Sqrt) {
+            let x0 = if matches!(f, Function::Log | Function::Sqrt | Function::Acosh) {
                 1.5
             } else {
                 0.3
