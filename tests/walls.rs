@@ -561,10 +561,10 @@ impl Surfaces<2> for Misled<'_> {
 /// x·y): whether its P depends on q, and every other zero test of the
 /// derivation, is settled by the expression's values with those functions
 /// valued too, not by expanding it. Before they were valued, that test
-/// expanded P's derivatives: `generate` reached 2 GB in 3 s (stopped there
-/// by an address-space limit; the same wall beside a potential with asinh
-/// and atanh ran to 24 GB and was killed); without the product x·y it took
-/// 12 s and 350 MB, now 0.2 s.
+/// expanded P's derivatives: `generate` reached 1.7 GB in 3 s (stopped
+/// there by an address-space limit; the same wall beside a potential with
+/// asinh and atanh ran to 24 GB and was killed); without the product x·y
+/// it took 12 s and 350 MB, now 0.2 s.
 #[test]
 fn functions_the_engine_lacks_keep_the_derivation_bounded() {
     let start = std::time::Instant::now();
