@@ -18,3 +18,11 @@ pub fn children(a: AtomView<'_>) -> Vec<AtomView<'_>> {
         AtomView::Var(_) | AtomView::Num(_) => Vec::new(),
     }
 }
+
+/// The one argument of an application.
+pub fn argument(app: &Atom) -> Atom {
+    match app.as_view() {
+        AtomView::Fun(f) => f.iter().next().expect("one argument").to_owned(),
+        _ => unreachable!("an application"),
+    }
+}

@@ -104,7 +104,8 @@ const NATIVE: [Function; 6] = [
 ];
 
 /// The functions of the language symbolica does not have: every other one
-/// (atan, asin, acos, sinh, cosh, tanh), each a function of ours.
+/// (atan, asin, acos and the hyperbolic functions and their inverses),
+/// each a function of ours.
 pub fn own_function_list() -> impl Iterator<Item = Function> {
     Function::ALL.into_iter().filter(|f| !NATIVE.contains(f))
 }

@@ -20,7 +20,7 @@ use std::collections::HashMap;
 use symbolica::evaluate::{Instruction, Slot as ESlot};
 use symbolica::prelude::*;
 
-use super::atoms::children;
+use super::atoms::{argument, children};
 use super::build::{constant_symbol, own_functions, place};
 use super::coefficients;
 use crate::ir::Constant;
@@ -182,14 +182,6 @@ fn innermost(a: AtomView, ours: &[Symbol], out: &mut Vec<(Atom, Function)>) {
 fn contains_own(a: AtomView, ours: &[Symbol]) -> bool {
     matches!(a, AtomView::Fun(f) if ours.contains(&f.get_symbol()))
         || children(a).into_iter().any(|x| contains_own(x, ours))
-}
-
-/// The one argument of an application.
-fn argument(app: &Atom) -> Atom {
-    match app.as_view() {
-        AtomView::Fun(f) => f.iter().next().expect("one argument").to_owned(),
-        _ => unreachable!("an application"),
-    }
 }
 
 /// [`program_in_places`] for outputs in the functions symbolica's

@@ -31,7 +31,7 @@ use std::collections::{HashMap, HashSet};
 
 use symbolica::prelude::*;
 
-use super::atoms::children;
+use super::atoms::{argument, children};
 use super::build::own_functions;
 use crate::function::Function;
 
@@ -78,14 +78,6 @@ fn applications(a: AtomView, ours: &[Symbol], out: &mut Vec<(Atom, Function)>) {
         && !out.iter().any(|(b, _)| b.as_view() == a)
     {
         out.push((a.to_owned(), function));
-    }
-}
-
-/// The one argument of an application.
-fn argument(app: &Atom) -> Atom {
-    match app.as_view() {
-        AtomView::Fun(f) => f.iter().next().expect("one argument").to_owned(),
-        _ => unreachable!("an application"),
     }
 }
 
