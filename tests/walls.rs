@@ -573,3 +573,68 @@ fn functions_the_engine_lacks_keep_the_derivation_bounded() {
     assert!(took.as_secs_f64() < 30.0, "derived in {took:?}");
     assert!(!d.walls[0].structured(), "P in closed form");
 }
+
+/// A wall through six nested atan (`nested_atan.toml`): each level's
+/// derivative divides by 1 + u², so the normal in lowest terms over one
+/// common denominator has thousands of terms where the derivatives as
+/// differentiated have a few hundred. The reduced forms were the only ones
+/// compiled, and B's row (the normal) and the collision map were evaluated
+/// from them: at five levels `generate` took 113 s and gave a collision
+/// map of 1 056 operations; at six it ran past 120 s. Now an evaluated
+/// quantity is compiled as written too, the cheaper kept (here the
+/// written one), and a reduction past the budget is not made for it.
+///
+/// The normal and the collision map are checked against the surface's
+/// gradient by central differences (G = I: v⁺ = v − 2(n·v)/(n·n) n), and
+/// the motion against Dormand–Prince at rtol 1e-13.
+#[test]
+fn nested_functions_are_evaluated_as_written() {
+    use dalembert_codegen::quantity::Quantity;
+    let start = std::time::Instant::now();
+    let d = common::derived("tests/walls", "nested_atan");
+    let took = start.elapsed();
+    assert!(took.as_secs_f64() < 30.0, "derived in {took:?}");
+    let params = d.model.params.len();
+    let per_call = |q: Quantity| {
+        let f = d.walls[0].function(q).expect("the wall's function");
+        f.program.split(params, 0).op_counts(&f.program).0.cost()
+    };
+    // 86 and 111 here; 2 231 and 2 256 from the reduced forms.
+    for q in [Quantity::WallRows, Quantity::Collide] {
+        assert!(per_call(q) < 300, "{q:?}: {} operations", per_call(q));
+    }
+    let m = model::<3>("nested_atan");
+    let wall = m.walls()[0];
+    let mut seed = 7u64;
+    for _ in 0..20 {
+        let q: [f64; 3] = std::array::from_fn(|_| lcg(&mut seed) - 0.5);
+        let v: [f64; 3] = std::array::from_fn(|_| 2.0 * lcg(&mut seed) - 1.0);
+        let h = 1e-5;
+        let n: [f64; 3] = std::array::from_fn(|k| {
+            let (mut a, mut b) = (q, q);
+            a[k] += h;
+            b[k] -= h;
+            (m.surface(wall, &a) - m.surface(wall, &b)) / (2.0 * h)
+        });
+        let normal = m.normal(wall, &q);
+        let dot = |a: &[f64; 3], b: &[f64; 3]| (0..3).map(|k| a[k] * b[k]).sum::<f64>();
+        // The generated normal may be any non-zero multiple of ∇f.
+        let along = dot(&normal, &n) / dot(&n, &n);
+        for k in 0..3 {
+            assert!(
+                (normal[k] - along * n[k]).abs() <= 1e-8 * along.abs(),
+                "normal at {q:?}: {normal:?} against {n:?}"
+            );
+        }
+        let after = m.collide(wall, &q, &v);
+        let s = 2.0 * dot(&n, &v) / dot(&n, &n);
+        for k in 0..3 {
+            let expected = v[k] - s * n[k];
+            assert!(
+                (after[k] - expected).abs() <= 1e-8,
+                "v⁺ at {q:?}, {v:?}: {after:?}, by differences {expected}"
+            );
+        }
+    }
+    same_collisions::<3>("nested_atan", None, 10.0, 5);
+}

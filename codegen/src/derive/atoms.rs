@@ -26,3 +26,9 @@ pub fn argument(app: &Atom) -> Atom {
         _ => unreachable!("an application"),
     }
 }
+
+/// The number of expressions `a` is made of, itself included: the size of
+/// its tree, each shared part counted where it occurs.
+pub fn size(a: AtomView<'_>) -> usize {
+    1 + children(a).into_iter().map(size).sum::<usize>()
+}

@@ -115,6 +115,114 @@ impl Running {
     }
 }
 
+/// An upper bound on the terms of `a` as a rational function in lowest
+/// terms, numerator and denominator together, every symbol and function
+/// application one variable (as [`super::lower::Lowering`] writes it):
+/// over a common denominator, each base of a negative power counted once
+/// at its highest power, and products and integer powers multiplied out.
+///
+/// A derivative is compact as the symbolic engine writes it and can be
+/// exponential in this form: each level of a nested atan(u) divides by
+/// 1 + u², and the common denominator multiplies them all out.
+pub fn rational_terms(a: &Atom) -> f64 {
+    let f = fraction(a.as_view());
+    f.num + f.denominator()
+}
+
+/// A bound on a rational function's terms: its numerator's, and its
+/// denominator as the bases of negative powers, each with its power and
+/// its own bound.
+struct Fraction<'a> {
+    num: f64,
+    den: Vec<(AtomView<'a>, u32, f64)>,
+}
+
+impl Fraction<'_> {
+    fn one() -> Self {
+        Self {
+            num: 1.0,
+            den: Vec::new(),
+        }
+    }
+
+    /// The bound on the denominator's terms, multiplied out.
+    fn denominator(&self) -> f64 {
+        (self.den.iter())
+            .map(|&(_, k, t)| monomials(t, k))
+            .product()
+    }
+}
+
+/// The monomials of degree `k` in `t` terms: C(t + k − 1, k), the terms of
+/// a sum of `t` terms to the `k`th power.
+fn monomials(t: f64, k: u32) -> f64 {
+    (1..=k).fold(1.0, |c, i| c * (t + i as f64 - 1.0) / i as f64)
+}
+
+fn fraction(a: AtomView<'_>) -> Fraction<'_> {
+    match a {
+        AtomView::Add(s) => {
+            let parts: Vec<Fraction> = s.iter().map(fraction).collect();
+            // The common denominator: each base at its highest power.
+            let mut den: Vec<(AtomView, u32, f64)> = Vec::new();
+            for (b, k, t) in parts.iter().flat_map(|p| p.den.iter().copied()) {
+                match den.iter_mut().find(|d| d.0 == b) {
+                    Some(d) => d.1 = d.1.max(k),
+                    None => den.push((b, k, t)),
+                }
+            }
+            // Each numerator times the factors its own denominator lacks.
+            let num = (parts.iter())
+                .map(|p| {
+                    let missing: f64 = (den.iter())
+                        .map(|&(b, k, t)| {
+                            let own = (p.den.iter().find(|d| d.0 == b)).map_or(0, |d| d.1);
+                            monomials(t, k - own)
+                        })
+                        .product();
+                    p.num * missing
+                })
+                .sum();
+            Fraction { num, den }
+        }
+        AtomView::Mul(m) => m.iter().map(fraction).fold(Fraction::one(), |mut f, g| {
+            f.num *= g.num;
+            for (b, k, t) in g.den {
+                match f.den.iter_mut().find(|d| d.0 == b) {
+                    Some(d) => d.1 += k,
+                    None => f.den.push((b, k, t)),
+                }
+            }
+            f
+        }),
+        AtomView::Pow(p) => {
+            let (b, e) = p.get_base_exp();
+            let Ok(k) = e.to_string().parse::<i64>() else {
+                // A fractional power is one variable.
+                return Fraction::one();
+            };
+            let base = fraction(b);
+            let n = k.unsigned_abs().min(u32::MAX as u64) as u32;
+            if k >= 0 {
+                Fraction {
+                    num: monomials(base.num, n),
+                    den: (base.den.into_iter())
+                        .map(|(b, j, t)| (b, j.saturating_mul(n), t))
+                        .collect(),
+                }
+            } else {
+                // 1/(p/q)ⁿ = qⁿ/pⁿ: the base's numerator is the new
+                // denominator, counted as the base itself.
+                Fraction {
+                    num: monomials(base.denominator(), n),
+                    den: vec![(b, n, base.num)],
+                }
+            }
+        }
+        AtomView::Fun(_) | AtomView::Num(_) | AtomView::Var(_) => Fraction::one(),
+    }
+}
+
 /// (terms of the view's own expansion, largest expansion inside a power
 /// or function that stays unexpanded at this level).
 fn terms(a: AtomView) -> (f64, f64) {
@@ -328,6 +436,41 @@ mod tests {
         for a in [root.d(own_symbol("x")), product.d(own_symbol("x"))] {
             assert!(expansion_terms(&a) >= count(&a), "{a}");
         }
+    }
+
+    /// The bound on a rational function's terms is never below the count
+    /// and close to it on the derivatives of nested atan (each level
+    /// dividing by 1 + u²), with a shared denominator counted once.
+    #[test]
+    fn rational_bound_holds() {
+        crate::lock::acquire().unwrap();
+        let _ns = Namespace::enter("budget test");
+        let [x, y, z] = ["x", "y", "z"].map(|n| Atom::from(own_symbol(n)));
+        let count = |a: &Atom| {
+            let r: Rat = a.to_rational_polynomial(&Q, &Z, None);
+            (r.numerator.nterms() + r.denominator.nterms()) as f64
+        };
+        let one = Atom::num(1);
+        let shared = (&x + &y) / (&one + &x * &x) + &z / (&one + &x * &x);
+        assert_eq!(rational_terms(&shared), 5.0);
+        assert_eq!(count(&shared), 5.0);
+        let apart = &one / (&one + &x) + &one / (&one + &y);
+        assert!(rational_terms(&apart) >= count(&apart));
+        // ∂/∂z of atan(a_{n−1} + z) with a_k = atan(a_{k−1} + z) and
+        // a_0 = x·y, each atan a symbol of its own (as lowered).
+        let (mut u, mut d) = (&x * &y + &z, Atom::num(0));
+        let mut bounds = Vec::new();
+        for level in 1..=5 {
+            d = (d + &one) / (&one + &u * &u);
+            let (bound, terms) = (rational_terms(&d), count(&d));
+            assert!(
+                terms <= bound && bound <= 2.0 * terms,
+                "level {level}: {bound}, {terms}"
+            );
+            bounds.push(bound);
+            u = Atom::from(own_symbol(&format!("a{level}"))) + &z;
+        }
+        assert!(bounds[4] > 100.0 * bounds[0], "{bounds:?}");
     }
 
     /// The permanent by its definition: the sum over permutations.

@@ -45,19 +45,29 @@ impl Outputs {
     }
 }
 
-/// A wall's collision map by elimination over B's rows `b`. `None` where
-/// the model has no such function or a pivot is structurally zero.
+/// A wall's collision map by elimination over B's rows, the cheaper of
+/// its `forms` (each zero in the same entries, so that one layout places
+/// them all). `None` where the model has no such function or a pivot is
+/// structurally zero.
 pub fn collision(
     sym: &Symbols,
     exact: &Exact,
     compile: &Compiler<'_>,
     cx: &mut Collector,
-    b: &[Vec<Atom>],
+    forms: &[Vec<Vec<Atom>>],
     span: &Range<usize>,
 ) -> Result<Option<Function>, Reported> {
-    let mut outputs = Outputs::default();
-    let layout = outputs.layout(exact, b);
-    let Some(f) = compile.applicable(cx, Quantity::Collide, &outputs.0, 0, span)? else {
+    let placed: Vec<(Outputs, Layout)> = (forms.iter())
+        .map(|b| {
+            let mut outputs = Outputs::default();
+            let layout = outputs.layout(exact, b);
+            (outputs, layout)
+        })
+        .collect();
+    let layout = placed[0].1.clone();
+    debug_assert!(placed.iter().all(|(_, l)| *l == layout));
+    let outputs: Vec<&[Atom]> = placed.iter().map(|(o, _)| &o.0[..]).collect();
+    let Some(f) = compile.applicable_of(cx, Quantity::Collide, &outputs, 0, span)? else {
         return Ok(None);
     };
     let v = sym.params.len() + sym.coords.len();

@@ -13,13 +13,17 @@ use std::sync::Arc;
 
 use symbolica::prelude::*;
 
-use super::atoms::children;
+use super::atoms::{children, size};
 use super::budget::{self, Over};
 use super::build::{Differentiate, constant_symbol, own_constants, own_functions, own_symbol};
 use super::mechanics::Raw;
 use super::symbols::Symbols;
 use super::{Rat, is_zero};
 use crate::ir::{Constant, Function};
+
+/// How many times larger than an evaluated quantity as written its
+/// reduction may be and still be compiled to see which is cheaper.
+pub const REDUCED_GROWTH: usize = 10;
 
 /// A function application replaced by a symbol while matrices are computed.
 struct Lowered {
@@ -142,8 +146,9 @@ impl Lowering {
 
     /// `a` as a rational function of the model's symbols and the lowered
     /// function applications, its numerator and denominator reduced by
-    /// sin² + cos² = 1 and cosh² − sinh² = 1 ([`Over`] where that is past
-    /// the budget).
+    /// sin² + cos² = 1 and cosh² − sinh² = 1 ([`Over`] where the bound on
+    /// its terms, [`budget::rational_terms`], or that reduction is past the
+    /// budget).
     ///
     /// The exact linear algebra works with rational functions of sin and
     /// cos as independent symbols. Reduced, an entry that vanishes by the
@@ -152,9 +157,10 @@ impl Lowering {
     /// by them are equal. Combinations that vanish only by the identities
     /// after elimination are not seen (the note in `docs/model-format.md`).
     pub fn to_rat(&self, a: &Atom) -> Result<Rat, Over> {
-        self.reduce_rat(self.rat(&self.lower(a)))
+        let lowered = self.lower(a);
+        budget::check(budget::rational_terms(&lowered))?;
+        self.reduce_rat(self.rat(&lowered))
     }
-
     /// A rational function of the lowered symbols with its numerator and
     /// denominator reduced by the identities, as [`Lowering::to_rat`]
     /// gives one.
@@ -229,6 +235,30 @@ impl Lowering {
     /// [`Lowering::simplify`] of an expression.
     pub fn reduce(&self, a: &Atom) -> Result<Atom, Over> {
         self.simplify(&self.to_rat(a)?)
+    }
+
+    /// The forms an evaluated quantity is compiled from, the cheaper kept:
+    /// `written`, then its reduction ([`Lowering::reduce_or_keep`]) where
+    /// that differs and is at most [`REDUCED_GROWTH`] times its size.
+    pub fn evaluated_forms(&self, written: Vec<Atom>) -> Result<Vec<Vec<Atom>>, Over> {
+        let reduced =
+            (written.iter().map(|a| self.reduce_or_keep(a))).collect::<Result<Vec<_>, _>>()?;
+        let size = |f: &[Atom]| f.iter().map(|a| size(a.as_view())).sum::<usize>();
+        let keep = reduced != written && size(&reduced) <= REDUCED_GROWTH * size(&written);
+        Ok(std::iter::once(written)
+            .chain(Some(reduced).filter(|_| keep))
+            .collect())
+    }
+
+    /// [`Lowering::reduce`] of an expression that is only evaluated, or
+    /// the expression as written where its reduction is past the budget:
+    /// evaluation needs no normal form, and a compact expression can have
+    /// an exponential one (a wall's Hessian form through nested atan).
+    pub fn reduce_or_keep(&self, a: &Atom) -> Result<Atom, Over> {
+        match self.reduce(a) {
+            Err(Over::Terms(_)) => Ok(a.clone()),
+            reduced => reduced,
+        }
     }
 
     /// v⁺ component printed as a combination of the velocities.
@@ -313,9 +343,9 @@ impl<'l> Echelon<'l> {
 }
 
 /// What a reduction past the budget names in its error: `what` (a
-/// quantity), reduced by sin² + cos² = 1.
+/// quantity) in the form the exact algebra works with.
 pub fn reduced(what: &str) -> String {
-    format!("{what}, reduced by sin² + cos² = 1,")
+    format!("{what}, as an exact rational function with sin² + cos² = 1 applied,")
 }
 
 /// Whether `a` is zero as a rational function of its symbols and function

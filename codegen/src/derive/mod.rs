@@ -103,18 +103,17 @@ fn run(model: &Model, cx: &mut Collector) -> Result<Derivation, Reported> {
     let accelerations = mechanics::accelerations(&sym, &low, &raw, &exact, g_inv.as_ref(), cx)?;
     let a_flat: Vec<Atom> = raw.a_rows.iter().flatten().cloned().collect();
     let mut functions = vec![Some(mass_matrix)];
-    let reduced_t = (low.reduce(&raw.t))
+    let reduced_t = (low.reduce_or_keep(&raw.t))
         .map_err(|o| o.report(cx, t_span, &lower::reduced("the kinetic energy")))?;
     let v_span = model.potential.as_ref().map_or(t_span, |v| &v.span);
-    let reduced_v =
-        (low.reduce(&raw.v)).map_err(|o| o.report(cx, v_span, &lower::reduced("the potential")))?;
+    let reduced_v = (low.reduce_or_keep(&raw.v))
+        .map_err(|o| o.report(cx, v_span, &lower::reduced("the potential")))?;
     // A's rows and their rates as written, or reduced where that is
     // cheaper: a rolling disk's rows divide by its centre's height, which
     // the reduction cancels.
     let or_reduced = |outputs: Vec<Atom>| {
-        let reduced: Option<Vec<Atom>> = outputs.iter().map(|a| low.reduce(a).ok()).collect();
-        let reduced = reduced.filter(|r| *r != outputs);
-        std::iter::once(outputs).chain(reduced).collect::<Vec<_>>()
+        low.evaluated_forms(outputs.clone())
+            .unwrap_or_else(|_| vec![outputs])
     };
     for (quantity, forms, rows) in [
         (Quantity::KineticEnergy, vec![vec![reduced_t]], 0),

@@ -5,11 +5,12 @@
 
 use symbolica::prelude::*;
 
+use super::atoms::size;
 use super::budget::{self, Over};
 use super::build::Differentiate;
 use super::checks::{self, WallRows};
 use super::elimination;
-use super::lower::{self, Echelon, Lowering};
+use super::lower::{self, Echelon, Lowering, REDUCED_GROWTH};
 use super::mechanics::{Exact, Raw, RawWall};
 use super::output::{Form, Function, Geometry, Projection, WallDerivation};
 use super::symbols::Symbols;
@@ -59,8 +60,8 @@ fn wall(
     let Some(b) = rows(c, cx, w, raw)? else {
         return Ok(None);
     };
-    let (b_mat, b_atoms, kept, dropped, steady) =
-        (b.matrix, b.atoms, b.origin, b.dropped, b.steady);
+    let (b_mat, b_atoms, b_forms, kept, dropped, steady) =
+        (b.matrix, b.atoms, b.forms, b.origin, b.dropped, b.steady);
     // `auto` weighs B too: a closed-form P divides by det(BG⁻¹Bᵀ), and a
     // wall whose estimate is past the budget is solved at run time (where
     // the kept rows span the rest everywhere; elsewhere only the closed
@@ -84,7 +85,7 @@ fn wall(
     let closed = match g_inv {
         Some(g_inv) => Some(
             (closed_form(sym, low, g_inv, &b_mat))
-                .map_err(|o| reduced(o, cx, &w.span, "the projector P"))?
+                .map_err(|o| reduced(o, cx, w, "the projector P"))?
                 .ok_or_else(|| {
                     cx.error(
                 ErrorKind::Structure(format!(
@@ -96,27 +97,34 @@ fn wall(
         })?),
         None => None,
     };
-    let normal = (raw.normal.iter().map(|a| low.reduce(a)))
-        .collect::<Result<Vec<Atom>, _>>()
-        .map_err(|o| reduced(o, cx, &w.span, "the normal"))?;
-    let hessian =
-        (low.reduce(&raw.hessian)).map_err(|o| reduced(o, cx, &w.span, "the Hessian form"))?;
-    let mut normal_velocity = Atom::num(0);
-    for (k, row) in normal.iter().enumerate() {
-        normal_velocity += row.clone() * sym.vel(k);
-    }
-    let b_flat: Vec<Atom> = b_atoms.iter().flatten().cloned().collect();
+    let normal =
+        (low.evaluated_forms(raw.normal.clone())).map_err(|o| reduced(o, cx, w, "the normal"))?;
+    let hessian = (low.evaluated_forms(vec![raw.hessian.clone()]))
+        .map_err(|o| reduced(o, cx, w, "the Hessian form"))?;
+    let normal_velocity: Vec<Vec<Atom>> = (normal.iter())
+        .map(|n| {
+            let mut v = Atom::num(0);
+            for (k, row) in n.iter().enumerate() {
+                v += row.clone() * sym.vel(k);
+            }
+            vec![v]
+        })
+        .collect();
+    let b_flat: Vec<Vec<Atom>> = (b_forms.iter())
+        .map(|f| f.iter().flatten().cloned().collect())
+        .collect();
     let mut functions = Vec::new();
-    for (quantity, outputs, rows) in [
-        (Quantity::Surface, vec![raw.surface.clone()], 0),
+    for (quantity, forms, rows) in [
+        (Quantity::Surface, vec![vec![raw.surface.clone()]], 0),
         (Quantity::Normal, normal, 0),
-        (Quantity::NormalVelocity, vec![normal_velocity], 0),
-        (Quantity::SurfaceHessian, vec![hessian], 0),
+        (Quantity::NormalVelocity, normal_velocity, 0),
+        (Quantity::SurfaceHessian, hessian, 0),
         (Quantity::WallRows, b_flat, b_atoms.len()),
     ] {
+        let forms: Vec<&[Atom]> = forms.iter().map(|f| &f[..]).collect();
         functions.extend(
             c.compile
-                .applicable(cx, quantity, &outputs, rows, &w.span)?,
+                .applicable_of(cx, quantity, &forms, rows, &w.span)?,
         );
     }
     let mut candidates = Vec::new();
@@ -137,7 +145,7 @@ fn wall(
                 if let Some(f) = linear_map(c, cx, &m, &vec![false; m.len()], &w.span)? {
                     candidates.push((Form::Linear, f));
                 }
-                if let Some(f) = admissible_collision(c, cx, &m, &w.span)? {
+                if let Some(f) = admissible_collision(c, cx, &m, w)? {
                     candidates.push((Form::Admissible, f));
                 }
             }
@@ -152,14 +160,14 @@ fn wall(
                 collision: (collide.iter())
                     .map(|x| low.collect_velocities(sym, x))
                     .collect::<Result<_, _>>()
-                    .map_err(|o| reduced(o, cx, &w.span, "the collision map"))?,
+                    .map_err(|o| reduced(o, cx, w, "the collision map"))?,
             }
         }
         None => Projection::Structured,
     };
     // Elimination evaluates B's kept rows: only where they span the rest.
     if steady
-        && let Some(f) = elimination::collision(c.sym, c.exact, c.compile, cx, &b_atoms, &w.span)?
+        && let Some(f) = elimination::collision(c.sym, c.exact, c.compile, cx, &b_forms, &w.span)?
     {
         candidates.push((Form::Elimination, f));
     }
@@ -191,6 +199,8 @@ struct WallB {
     rats: Vec<Vec<Rat>>,
     /// The rows as expressions, functions raised.
     atoms: Vec<Vec<Atom>>,
+    /// The rows to evaluate ([`row_forms`]), the cheaper compiled.
+    forms: Vec<Vec<Vec<Atom>>>,
     origin: Vec<String>,
     dropped: Vec<String>,
     /// Whether the kept rows span the dropped ones everywhere ([`steady`]).
@@ -211,19 +221,27 @@ fn rows(
     let n = sym.vels.len();
     let normal_r: Vec<Rat> = (raw.normal.iter().map(|a| low.to_rat(a)))
         .collect::<Result<_, _>>()
-        .map_err(|o| reduced(o, cx, &w.span, "the normal"))?;
+        .map_err(|o| reduced(o, cx, w, "the normal"))?;
     let mut candidates = vec![(normal_r, "the normal velocity".to_string())];
-    for (r, label) in exact.a.iter().zip(&c.raw.a_labels) {
+    // Each candidate as written, to be evaluated where that is cheaper.
+    let mut written = vec![raw.normal.clone()];
+    for ((r, label), row) in exact.a.iter().zip(&c.raw.a_labels).zip(&c.raw.a_rows) {
         candidates.push((r.clone(), label.clone()));
+        written.push(row.clone());
     }
     for (k, row) in raw.contact.iter().enumerate() {
         let r = (row.iter().map(|a| low.to_rat(a)))
             .collect::<Result<_, _>>()
-            .map_err(|o| reduced(o, cx, &w.span, "a contact row"))?;
+            .map_err(|o| reduced(o, cx, w, "a contact row"))?;
         candidates.push((r, format!("contact constraint {}", k + 1)));
+        written.push(row.clone());
     }
-    let (kept, dropped) =
-        independent_rows(&candidates, low).map_err(|o| reduced(o, cx, &w.span, "the rows of B"))?;
+    let (kept_at, dropped_at) =
+        independent_rows(&candidates, low).map_err(|o| reduced(o, cx, w, "the rows of B"))?;
+    let (kept, dropped): (Vec<_>, Vec<_>) = (
+        kept_at.iter().map(|&i| candidates[i].clone()).collect(),
+        dropped_at.iter().map(|&i| candidates[i].clone()).collect(),
+    );
     let b: Vec<Vec<Rat>> = kept.iter().map(|(r, _)| r.clone()).collect();
     let spans = steady(
         c,
@@ -231,10 +249,10 @@ fn rows(
         &dropped.iter().map(|(r, _)| r.clone()).collect::<Vec<_>>(),
         n,
     )
-    .map_err(|o| reduced(o, cx, &w.span, "the rows of B"))?;
+    .map_err(|o| reduced(o, cx, w, "the rows of B"))?;
     let dropped: Vec<String> = dropped.into_iter().map(|(_, o)| o).collect();
     checks::wall_hypotheses(cx, w, &b, &exact.a, &candidates[0].0, low)
-        .map_err(|o| reduced(o, cx, &w.span, "the rows of B"))?;
+        .map_err(|o| reduced(o, cx, w, "the rows of B"))?;
     if kept.is_empty() {
         return Ok(None);
     }
@@ -248,6 +266,8 @@ fn rows(
         .iter()
         .map(|r| r.iter().map(|x| low.raise(&x.to_expression())).collect())
         .collect();
+    let written: Vec<Vec<Atom>> = kept_at.iter().map(|&i| written[i].clone()).collect();
+    let forms = row_forms(written, &atoms);
     if sym.model.kind == Kind::Coordinates {
         let rows = WallRows {
             surface: &raw.surface,
@@ -262,6 +282,7 @@ fn rows(
         matrix,
         rats: b,
         atoms,
+        forms,
         origin: kept.into_iter().map(|(_, o)| o).collect(),
         dropped,
         steady: spans,
@@ -309,7 +330,7 @@ fn admissible_collision(
     c: &Context,
     cx: &mut Collector,
     m: &[Vec<Atom>],
-    span: &std::ops::Range<usize>,
+    w: &Wall,
 ) -> Result<Option<Function>, Reported> {
     let (a, field, low) = (&c.exact.a, &c.exact.field, c.low);
     let (n, k) = (c.sym.vels.len(), a.len());
@@ -332,8 +353,7 @@ fn admissible_collision(
         let Ok(inv) = a_d.inv() else {
             continue;
         };
-        let t =
-            simplified(low, &(&inv * &a_mat), k, n).map_err(|o| reduced(o, cx, span, ON_KER_A))?;
+        let t = simplified(low, &(&inv * &a_mat), k, n).map_err(|o| reduced(o, cx, w, ON_KER_A))?;
         if !t.iter().flatten().any(|e| varies(c, e)) {
             through.push((d, t));
         }
@@ -353,7 +373,7 @@ fn admissible_collision(
                     .collect()
             })
             .collect::<Result<_, _>>()
-            .map_err(|o| reduced(o, cx, span, ON_KER_A))?;
+            .map_err(|o| reduced(o, cx, w, ON_KER_A))?;
         let rows: Vec<usize> = folded.iter().map(|r| row_cost(r)).collect();
         // Outputs E computed from the others (rows over v⁺), each where
         // that is cheaper; E = ∅ first.
@@ -387,7 +407,7 @@ fn admissible_collision(
     }
     let plain: usize = m.iter().map(|r| row_cost(r)).sum();
     match best {
-        Some((total, rows, over)) if total < plain => linear_map(c, cx, &rows, &over, span),
+        Some((total, rows, over)) if total < plain => linear_map(c, cx, &rows, &over, &w.span),
         _ => Ok(None),
     }
 }
@@ -411,8 +431,13 @@ fn row_cost(row: &[Atom]) -> usize {
 const ON_KER_A: &str = "the collision map on admissible velocities";
 
 /// The error of a reduction past the budget in `what`, at the wall's `span`.
-fn reduced(o: Over, cx: &mut Collector, span: &std::ops::Range<usize>, what: &str) -> Reported {
-    o.report(cx, span, &lower::reduced(what))
+/// `o` reported at wall `w`, naming `what` of it.
+fn reduced(o: Over, cx: &mut Collector, w: &Wall, what: &str) -> Reported {
+    o.report(
+        cx,
+        &w.span,
+        &lower::reduced(&format!("{what} of wall `{}`", w.name)),
+    )
 }
 
 /// The entries of a rows × cols matrix, simplified.
@@ -535,21 +560,40 @@ fn projector(g_inv: &Matrix<Field>, b: &Matrix<Field>) -> Option<Matrix<Field>> 
     Some(&(&x * &m_inv) * b)
 }
 
+/// B's kept rows to evaluate: as `written` where each entry is zero
+/// exactly where the `reduced` row's is (the elimination places the
+/// entries that are not zero, and a written entry that vanishes only by
+/// sin² + cos² = 1 would be placed), then reduced, by
+/// [`Lowering::evaluated_forms`]'s rule (the reduced alone where the
+/// zeros differ).
+fn row_forms(written: Vec<Vec<Atom>>, reduced: &[Vec<Atom>]) -> Vec<Vec<Vec<Atom>>> {
+    let same_zeros = (written.iter().flatten())
+        .zip(reduced.iter().flatten())
+        .all(|(w, r)| is_zero(w) == is_zero(r));
+    if !same_zeros {
+        return vec![reduced.to_vec()];
+    }
+    let size = |f: &[Vec<Atom>]| f.iter().flatten().map(|a| size(a.as_view())).sum::<usize>();
+    let keep = reduced != written && size(reduced) <= REDUCED_GROWTH * size(&written);
+    std::iter::once(written)
+        .chain(Some(reduced.to_vec()).filter(|_| keep))
+        .collect()
+}
+
 /// Keeps each candidate row that raises the rank (exactly, the identities
 /// holding: [`Echelon`]), in order; returns the kept rows and the dropped
-/// ones, with their descriptions.
-#[allow(clippy::type_complexity)]
+/// ones, by their places among the candidates.
 fn independent_rows(
     candidates: &[(Vec<Rat>, String)],
     low: &Lowering,
-) -> Result<(Vec<(Vec<Rat>, String)>, Vec<(Vec<Rat>, String)>), Over> {
+) -> Result<(Vec<usize>, Vec<usize>), Over> {
     let mut echelon = Echelon::new(low);
     let (mut kept, mut dropped) = (Vec::new(), Vec::new());
-    for (row, origin) in candidates {
+    for (k, (row, _)) in candidates.iter().enumerate() {
         if echelon.insert(row)? {
-            kept.push((row.clone(), origin.clone()));
+            kept.push(k);
         } else {
-            dropped.push((row.clone(), origin.clone()));
+            dropped.push(k);
         }
     }
     Ok((kept, dropped))
