@@ -188,8 +188,8 @@ fn derivative_rule(f: Function, z: Atom) -> Atom {
     factors.into_iter().fold(Atom::num(1), |acc, x| acc * x)
 }
 
-/// symbolica's expressions as the derivative rules' algebra.
-struct Atoms;
+/// symbolica's expressions as the function rules' algebra.
+pub(super) struct Atoms;
 
 impl Algebra for Atoms {
     type E = Atom;
@@ -201,6 +201,9 @@ impl Algebra for Atoms {
     }
     fn sub(&mut self, a: Atom, b: Atom) -> Atom {
         a - b
+    }
+    fn mul(&mut self, factors: Vec<Atom>) -> Atom {
+        factors.into_iter().fold(Atom::num(1), |acc, f| acc * f)
     }
     fn pow(&mut self, x: Atom, num: i64, den: i64) -> Atom {
         x.pow(Atom::num(num) / Atom::num(den))

@@ -32,8 +32,8 @@ use std::collections::{HashMap, HashSet};
 use symbolica::prelude::*;
 
 use super::atoms::{argument, children};
-use super::build::own_functions;
-use crate::function::Function;
+use super::build::{Atoms, own_functions};
+use crate::function::{Elementary, Function};
 
 /// The two precisions, in bits.
 const LOW: u32 = 128;
@@ -81,33 +81,18 @@ fn applications(a: AtomView, ours: &[Symbol], out: &mut Vec<(Atom, Function)>) {
     }
 }
 
-/// f(`z`) at precision `prec` for a function of ours: the hyperbolic ones
-/// and their inverses by exponentials and logarithms, which symbolica
-/// evaluates; atan, asin and acos by Newton's method on tan, sin and cos
-/// from libm's value, and only where the last step is below 2⁻⁽ᵖʳᵉᶜ⁻⁸⁾ of
-/// the result (else `None`: a value off in the same bits at both
-/// precisions could make a zero look like none).
+/// f(`z`) at precision `prec` for a function of ours, by its rule in the
+/// elementary functions ([`Function::elementary`]), which symbolica
+/// evaluates: a closed form (the hyperbolic functions and their inverses
+/// by exponentials and logarithms), or Newton's method from libm's value
+/// (atan, asin and acos on tan, sin and cos), used only where its last
+/// step is below 2⁻⁽ᵖʳᵉᶜ⁻⁸⁾ of the result (else `None`: a value off in
+/// the same bits at both precisions could make a zero look like none).
 fn own_value(f: Function, z: Float, prec: u32) -> Option<Float> {
-    let (y, x) = (
-        Atom::from(symbol!("dalembert_probe::y")),
+    let (x, y) = (
         Atom::from(symbol!("dalembert_probe::z")),
+        Atom::from(symbol!("dalembert_probe::y")),
     );
-    let (one, two, half) = (Atom::num(1), Atom::num(2), Atom::num(1) / Atom::num(2));
-    let exp = |a: Atom| function!(Symbol::EXP, a);
-    let log = |a: Atom| function!(Symbol::LOG, a);
-    let (sin, cos) = (
-        function!(Symbol::SIN, y.clone()),
-        function!(Symbol::COS, y.clone()),
-    );
-    let closed = match f {
-        Function::Sinh => Some((exp(x.clone()) - exp(-x.clone())) / &two),
-        Function::Cosh => Some((exp(x.clone()) + exp(-x.clone())) / &two),
-        Function::Tanh => Some(&one - &two / (exp(&two * &x) + &one)),
-        Function::Asinh => Some(log(&x + (x.pow(&two) + &one).pow(&half))),
-        Function::Acosh => Some(log(&x + (x.pow(&two) - &one).pow(&half))),
-        Function::Atanh => Some(log((&one + &x) / (&one - &x)) / &two),
-        _ => None,
-    };
     let at = |e: &Atom, y_value: Option<&Float>| {
         let mut map = HashMap::from([(x.clone(), z.clone())]);
         if let Some(v) = y_value {
@@ -115,24 +100,21 @@ fn own_value(f: Function, z: Float, prec: u32) -> Option<Float> {
         }
         e.evaluate_with_prec(&map, prec).ok()
     };
-    if let Some(e) = closed {
-        return at(&e, None).filter(|v| v.to_f64().is_finite());
+    match f.elementary(&mut Atoms, x.clone(), y.clone()) {
+        Elementary::Itself => None,
+        Elementary::Closed(e) => at(&e, None).filter(|v| v.to_f64().is_finite()),
+        Elementary::Newton(step) => {
+            let mut value = Float::with_val(prec, f.value(z.to_f64()));
+            let next = &y - &step;
+            for _ in 0..6 {
+                value = at(&next, Some(&value))?;
+            }
+            let last = at(&step, Some(&value))?.to_f64();
+            let size = value.to_f64();
+            (last.abs() <= size.abs() * 2f64.powi(8 - prec as i32) && size.is_finite())
+                .then_some(value)
+        }
     }
-    // Newton's step g/g′ for g(y) = 0 at y = f(z).
-    let step = match f {
-        Function::Atan => (&sin - &x * &cos) / (&cos + &x * &sin),
-        Function::Asin => (&sin - &x) / &cos,
-        Function::Acos => -(&cos - &x) / &sin,
-        _ => return None,
-    };
-    let mut value = Float::with_val(prec, f.value(z.to_f64()));
-    let next = &y - &step;
-    for _ in 0..6 {
-        value = at(&next, Some(&value))?;
-    }
-    let last = at(&step, Some(&value))?.to_f64();
-    let size = value.to_f64();
-    (last.abs() <= size.abs() * 2f64.powi(8 - prec as i32) && size.is_finite()).then_some(value)
 }
 
 /// The symbols `a` reads as variables (not the functions it applies).

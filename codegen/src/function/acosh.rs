@@ -1,7 +1,7 @@
 //! acosh: 1/√(x² − 1) is its derivative; its series is that integrated
 //! ([`Recurrences::arc`] with w = √(a² − 1)).
 
-use super::{Algebra, Fold, Function, Recurrences, Rules};
+use super::{Algebra, Elementary, Fold, Function, Recurrences, Rules};
 use dalembert_runtime::{interval::Interval, libm};
 
 pub(super) struct Acosh;
@@ -44,5 +44,13 @@ impl Rules for Acosh {
         let rest = r.sum(&[square], &[-1.0]);
         let w = r.sqrt(rest);
         r.arc(Function::Acosh, a, w, false)
+    }
+    fn elementary<A: Algebra>(a: &mut A, x: A::E, _: A::E) -> Elementary<A::E> {
+        // ln(x + √(x² − 1))
+        let (square, one) = (a.pow(x.clone(), 2, 1), a.number(1, 1));
+        let w = a.sub(square, one);
+        let root = a.pow(w, 1, 2);
+        let sum = a.add(vec![x, root]);
+        Elementary::Closed(a.call(Function::Log, sum))
     }
 }

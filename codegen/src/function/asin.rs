@@ -1,7 +1,9 @@
 //! asin: 1/√(1 − x²) is its derivative; its series is that integrated
 //! ([`Recurrences::arc`] with w = √(1 − a²)).
 
-use super::{Algebra, Fold, Function, Recurrences, Rules, arc_fold, one_minus, one_plus_square};
+use super::{
+    Algebra, Elementary, Fold, Function, Recurrences, Rules, arc_fold, one_minus, one_plus_square,
+};
 use dalembert_runtime::{interval::Interval, libm};
 
 pub(super) struct Asin;
@@ -26,5 +28,12 @@ impl Rules for Asin {
         let rest = one_plus_square(r, a, -1.0);
         let w = r.sqrt(rest);
         r.arc(Function::Asin, a, w, false)
+    }
+    fn elementary<A: Algebra>(a: &mut A, x: A::E, y: A::E) -> Elementary<A::E> {
+        // g = sin y − x: g/g′ = (sin y − x)/cos y
+        let (s, c) = (a.call(Function::Sin, y.clone()), a.call(Function::Cos, y));
+        let g = a.sub(s, x);
+        let over = a.pow(c, -1, 1);
+        Elementary::Newton(a.mul(vec![g, over]))
     }
 }

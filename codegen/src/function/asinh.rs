@@ -1,7 +1,9 @@
 //! asinh: 1/√(1 + x²) is its derivative; its series is that integrated
 //! ([`Recurrences::arc`] with w = √(1 + a²)).
 
-use super::{Algebra, Fold, Function, Recurrences, Rules, one_plus, one_plus_square, sloped};
+use super::{
+    Algebra, Elementary, Fold, Function, Recurrences, Rules, one_plus, one_plus_square, sloped,
+};
 use dalembert_runtime::{interval::Interval, libm};
 
 pub(super) struct Asinh;
@@ -26,5 +28,12 @@ impl Rules for Asinh {
         let rest = one_plus_square(r, a, 1.0);
         let w = r.sqrt(rest);
         r.arc(Function::Asinh, a, w, false)
+    }
+    fn elementary<A: Algebra>(a: &mut A, x: A::E, _: A::E) -> Elementary<A::E> {
+        // ln(x + √(x² + 1))
+        let w = one_plus(a, x.clone());
+        let root = a.pow(w, 1, 2);
+        let sum = a.add(vec![x, root]);
+        Elementary::Closed(a.call(Function::Log, sum))
     }
 }

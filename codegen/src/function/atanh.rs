@@ -1,7 +1,7 @@
 //! atanh: 1/(1 − x²) is its derivative; its series is that integrated
 //! ([`Recurrences::arc`] with w = 1 − a²).
 
-use super::{Algebra, Fold, Function, Recurrences, Rules, one_minus, one_plus_square};
+use super::{Algebra, Elementary, Fold, Function, Recurrences, Rules, one_minus, one_plus_square};
 use dalembert_runtime::{interval::Interval, libm};
 
 pub(super) struct Atanh;
@@ -33,5 +33,15 @@ impl Rules for Atanh {
     fn series<R: Recurrences>(r: &mut R, a: R::Series) -> R::Series {
         let w = one_plus_square(r, a, -1.0);
         r.arc(Function::Atanh, a, w, false)
+    }
+    fn elementary<A: Algebra>(a: &mut A, x: A::E, _: A::E) -> Elementary<A::E> {
+        // ln((1 + x)/(1 − x))/2
+        let one = a.number(1, 1);
+        let (up, down) = (a.add(vec![one.clone(), x.clone()]), a.sub(one, x));
+        let over = a.pow(down, -1, 1);
+        let ratio = a.mul(vec![up, over]);
+        let log = a.call(Function::Log, ratio);
+        let half = a.number(1, 2);
+        Elementary::Closed(a.mul(vec![half, log]))
     }
 }

@@ -1,7 +1,7 @@
 //! cos: −sin is its derivative, and sin and cos of one series are one pair
 //! of series.
 
-use super::{Algebra, Fold, Function, Recurrences, Rules, sloped};
+use super::{Algebra, Elementary, Fold, Function, Recurrences, Rules, sloped};
 use dalembert_runtime::{interval::Interval, libm};
 
 pub(super) struct Cos;
@@ -23,5 +23,8 @@ impl Rules for Cos {
     }
     fn series<R: Recurrences>(r: &mut R, a: R::Series) -> R::Series {
         r.sin_cos(a).1
+    }
+    fn elementary<A: Algebra>(_: &mut A, _: A::E, _: A::E) -> Elementary<A::E> {
+        Elementary::Itself
     }
 }

@@ -1,6 +1,9 @@
 //! cosh: sinh is its derivative; its series is (eᵃ + 1/eᵃ)/2.
 
-use super::{Algebra, Fold, Function, Recurrences, Rules, exponentials, hyperbolic_fold};
+use super::{
+    Algebra, Elementary, Fold, Function, Recurrences, Rules, exponentials, half_exponentials,
+    hyperbolic_fold,
+};
 use dalembert_runtime::{interval::Interval, libm};
 
 pub(super) struct Cosh;
@@ -22,5 +25,8 @@ impl Rules for Cosh {
     }
     fn series<R: Recurrences>(r: &mut R, a: R::Series) -> R::Series {
         exponentials(r, a, false)
+    }
+    fn elementary<A: Algebra>(a: &mut A, x: A::E, _: A::E) -> Elementary<A::E> {
+        Elementary::Closed(half_exponentials(a, x, false))
     }
 }

@@ -1,6 +1,6 @@
 //! exp: its own derivative, and its own recurrence.
 
-use super::{Algebra, Fold, Recurrences, Rules};
+use super::{Algebra, Elementary, Fold, Recurrences, Rules};
 use dalembert_runtime::{interval::Interval, libm};
 
 pub(super) struct Exp;
@@ -26,5 +26,8 @@ impl Rules for Exp {
     }
     fn series<R: Recurrences>(r: &mut R, a: R::Series) -> R::Series {
         r.exp(a)
+    }
+    fn elementary<A: Algebra>(_: &mut A, _: A::E, _: A::E) -> Elementary<A::E> {
+        Elementary::Itself
     }
 }

@@ -1,6 +1,6 @@
 //! log, the natural logarithm: 1/x is its derivative; its own recurrence.
 
-use super::{Algebra, Fold, Recurrences, Rules, not_real};
+use super::{Algebra, Elementary, Fold, Recurrences, Rules, not_real};
 use dalembert_runtime::{interval::Interval, libm};
 
 pub(super) struct Log;
@@ -33,5 +33,8 @@ impl Rules for Log {
     }
     fn series<R: Recurrences>(r: &mut R, a: R::Series) -> R::Series {
         r.log(a)
+    }
+    fn elementary<A: Algebra>(_: &mut A, _: A::E, _: A::E) -> Elementary<A::E> {
+        Elementary::Itself
     }
 }

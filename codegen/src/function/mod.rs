@@ -4,10 +4,13 @@
 //! implementation of [`Rules`]: its name (in model files, and of the
 //! runtime's libm and `Interval` functions emitted code calls), its value
 //! and interval enclosure, its exact value at 0, how a constant argument
-//! known to within a rounding error folds, its derivative and its Taylor
-//! series. The derivative and the series are written against small
-//! traits ([`Algebra`], [`Recurrences`]) that the stages implement, so
-//! this module imports no stage and every stage reads the same rule.
+//! known to within a rounding error folds, its derivative, its Taylor
+//! series, and how it is written in the elementary functions (sin, cos,
+//! exp, log and powers) for the symbolic stage's zero tests at any
+//! precision ([`Elementary`]). The derivative, the series and the
+//! elementary form are written against small traits ([`Algebra`],
+//! [`Recurrences`]) that the stages implement, so this module imports no
+//! stage and every stage reads the same rule.
 //!
 //! A new function is one file implementing [`Rules`] and its line in the
 //! `functions!` list below. What symbolica knows of it is said in one
@@ -43,6 +46,8 @@ pub trait Algebra {
     fn add(&mut self, terms: Vec<Self::E>) -> Self::E;
     /// `a − b`.
     fn sub(&mut self, a: Self::E, b: Self::E) -> Self::E;
+    /// The product of `factors`.
+    fn mul(&mut self, factors: Vec<Self::E>) -> Self::E;
     /// `x` to the power `num/den`.
     fn pow(&mut self, x: Self::E, num: i64, den: i64) -> Self::E;
     /// `f(x)`.
@@ -76,6 +81,19 @@ pub trait Recurrences {
     /// The series `c` with `c′ = a′/w` (`−a′/w` where `minus`) and
     /// `c₀ = f(a₀)`: atan, asin and acos.
     fn arc(&mut self, f: Function, a: Self::Series, w: Self::Series, minus: bool) -> Self::Series;
+}
+
+/// A function in the elementary functions that evaluators at any precision
+/// have (sin, cos, exp, log and powers): how the symbolic stage's zero
+/// tests value the others.
+pub enum Elementary<E> {
+    /// It is one of them.
+    Itself,
+    /// f(x) written in them.
+    Closed(E),
+    /// f(x) is the root of g(x, y) = 0 in y near its f64 value: Newton's
+    /// step g/(∂g/∂y) at y.
+    Newton(E),
 }
 
 /// A constant argument's value folded through a function.
@@ -118,6 +136,9 @@ trait Rules {
     fn derivative<A: Algebra>(a: &mut A, x: A::E, y: A::E) -> Vec<A::E>;
     /// The series of f(`a`).
     fn series<R: Recurrences>(r: &mut R, a: R::Series) -> R::Series;
+    /// f(`x`) in the elementary functions, `y` standing for f(`x`) in a
+    /// Newton step.
+    fn elementary<A: Algebra>(a: &mut A, x: A::E, y: A::E) -> Elementary<A::E>;
 }
 
 /// The registration: each function's variant and the type in its file
@@ -181,6 +202,14 @@ macro_rules! functions {
             pub fn derivative<A: Algebra>(self, a: &mut A, x: A::E, y: A::E) -> Vec<A::E> {
                 match self {
                     $(Self::$variant => <$rules as Rules>::derivative(a, x, y),)*
+                }
+            }
+
+            /// f(`x`) in the elementary functions, `y` standing for
+            /// f(`x`) in a Newton step.
+            pub fn elementary<A: Algebra>(self, a: &mut A, x: A::E, y: A::E) -> Elementary<A::E> {
+                match self {
+                    $(Self::$variant => <$rules as Rules>::elementary(a, x, y),)*
                 }
             }
 
@@ -300,6 +329,19 @@ fn arc_fold(name: &str, f: fn(f64) -> f64, x: f64, error: f64) -> Result<Fold, S
     })
 }
 
+/// sinh (`minus`) or cosh of `x` as (eˣ ∓ 1/eˣ)/2.
+fn half_exponentials<A: Algebra>(a: &mut A, x: A::E, minus: bool) -> A::E {
+    let e = a.call(Function::Exp, x);
+    let over = a.pow(e.clone(), -1, 1);
+    let both = if minus {
+        a.sub(e, over)
+    } else {
+        a.add(vec![e, over])
+    };
+    let half = a.number(1, 2);
+    a.mul(vec![half, both])
+}
+
 /// The series of sinh (`minus`) or cosh of `a`: (eᵃ ∓ 1/eᵃ)/2.
 fn exponentials<R: Recurrences>(r: &mut R, a: R::Series, minus: bool) -> R::Series {
     let e = r.exp(a);
@@ -340,6 +382,9 @@ mod tests {
         fn sub(&mut self, a: f64, b: f64) -> f64 {
             a - b
         }
+        fn mul(&mut self, factors: Vec<f64>) -> f64 {
+            factors.iter().product()
+        }
         fn pow(&mut self, x: f64, num: i64, den: i64) -> f64 {
             x.powf(num as f64 / den as f64)
         }
@@ -356,6 +401,41 @@ mod tests {
             _ => 0.0,
         };
         [-0.7, -0.2, 0.3, 0.9].map(|x| x + shift)
+    }
+
+    /// Every function's rule in the elementary functions gives its value:
+    /// the closed forms to rounding, Newton's step from a start off by
+    /// 10⁻³ to rounding in six steps; the elementary functions are
+    /// themselves.
+    #[test]
+    fn elementary_rules_give_the_values() {
+        for f in Function::ALL {
+            for x in points(f) {
+                let want = f.value(x);
+                let got = match f.elementary(&mut Numbers, x, f64::NAN) {
+                    Elementary::Itself => {
+                        use Function::*;
+                        assert!([Sin, Cos, Exp, Log, Sqrt].contains(&f), "{f:?}");
+                        continue;
+                    }
+                    Elementary::Closed(v) => v,
+                    Elementary::Newton(_) => {
+                        let mut y = want + 1e-3;
+                        for _ in 0..6 {
+                            let Elementary::Newton(step) = f.elementary(&mut Numbers, x, y) else {
+                                unreachable!()
+                            };
+                            y -= step;
+                        }
+                        y
+                    }
+                };
+                assert!(
+                    (got - want).abs() <= 1e-14 * want.abs().max(1.0),
+                    "{f:?} at {x}: {got} against {want}"
+                );
+            }
+        }
     }
 
     /// Every function's derivative rule against central differences of

@@ -1,7 +1,7 @@
 //! sin: cos is its derivative, and sin and cos of one series are one pair
 //! of series.
 
-use super::{Algebra, Fold, Function, Recurrences, Rules, sloped};
+use super::{Algebra, Elementary, Fold, Function, Recurrences, Rules, sloped};
 use dalembert_runtime::{interval::Interval, libm};
 
 pub(super) struct Sin;
@@ -23,5 +23,8 @@ impl Rules for Sin {
     }
     fn series<R: Recurrences>(r: &mut R, a: R::Series) -> R::Series {
         r.sin_cos(a).0
+    }
+    fn elementary<A: Algebra>(_: &mut A, _: A::E, _: A::E) -> Elementary<A::E> {
+        Elementary::Itself
     }
 }

@@ -1,7 +1,7 @@
 //! sqrt: 1/(2√x) is its derivative; its own recurrence. (Programs carry a
 //! root as the machine form `Sqrt`, which can fold a reciprocal in.)
 
-use super::{Algebra, Fold, Recurrences, Rules, not_real};
+use super::{Algebra, Elementary, Fold, Recurrences, Rules, not_real};
 use dalembert_runtime::{interval::Interval, libm};
 
 pub(super) struct Sqrt;
@@ -37,5 +37,8 @@ impl Rules for Sqrt {
     }
     fn series<R: Recurrences>(r: &mut R, a: R::Series) -> R::Series {
         r.sqrt(a)
+    }
+    fn elementary<A: Algebra>(_: &mut A, _: A::E, _: A::E) -> Elementary<A::E> {
+        Elementary::Itself
     }
 }

@@ -2,7 +2,7 @@
 //! (The symbolic stage writes it as sin/cos before programs are made, so
 //! programs meet it only when built by hand.)
 
-use super::{Algebra, Fold, Recurrences, Rules, one_plus};
+use super::{Algebra, Elementary, Fold, Function, Recurrences, Rules, one_plus};
 use dalembert_runtime::{interval::Interval, libm};
 
 pub(super) struct Tan;
@@ -35,5 +35,10 @@ impl Rules for Tan {
         let (sin, cos) = r.sin_cos(a);
         let over = r.recip(cos);
         r.product(sin, over)
+    }
+    fn elementary<A: Algebra>(a: &mut A, x: A::E, _: A::E) -> Elementary<A::E> {
+        let (s, c) = (a.call(Function::Sin, x.clone()), a.call(Function::Cos, x));
+        let over = a.pow(c, -1, 1);
+        Elementary::Closed(a.mul(vec![s, over]))
     }
 }

@@ -1,7 +1,7 @@
 //! tanh: 1 − tanh² is its derivative; its series is 1 − 2/(e²ᵃ + 1),
 //! which stays finite where eᵃ does not.
 
-use super::{Algebra, Fold, Recurrences, Rules, one_minus, sloped};
+use super::{Algebra, Elementary, Fold, Function, Recurrences, Rules, one_minus, sloped};
 use dalembert_runtime::{interval::Interval, libm};
 
 pub(super) struct Tanh;
@@ -28,5 +28,15 @@ impl Rules for Tanh {
         let over = r.recip(plus_one);
         let scaled = r.scale(over, -2.0);
         r.sum(&[scaled], &[1.0])
+    }
+    fn elementary<A: Algebra>(a: &mut A, x: A::E, _: A::E) -> Elementary<A::E> {
+        // 1 − 2/(e²ˣ + 1)
+        let (one, two) = (a.number(1, 1), a.number(2, 1));
+        let twice = a.mul(vec![two.clone(), x]);
+        let e = a.call(Function::Exp, twice);
+        let below = a.add(vec![e, one.clone()]);
+        let over = a.pow(below, -1, 1);
+        let part = a.mul(vec![two, over]);
+        Elementary::Closed(a.sub(one, part))
     }
 }

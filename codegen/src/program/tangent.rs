@@ -318,6 +318,9 @@ impl Algebra for Tangent {
     fn sub(&mut self, a: Slot, b: Slot) -> Slot {
         self.emit(|d| Instr::Sub(d, [a, b]))
     }
+    fn mul(&mut self, factors: Vec<Slot>) -> Slot {
+        self.product(factors)
+    }
     fn pow(&mut self, x: Slot, num: i64, den: i64) -> Slot {
         if den == 1 {
             self.emit(|d| Instr::Pow(d, x, num))

@@ -192,6 +192,9 @@ impl Algebra for Trees {
     fn sub(&mut self, a: Sym, b: Sym) -> Sym {
         sub(a, b)
     }
+    fn mul(&mut self, factors: Vec<Sym>) -> Sym {
+        mul(factors)
+    }
     fn pow(&mut self, x: Sym, num: i64, den: i64) -> Sym {
         let (num, den) = (i128::from(num), i128::from(den));
         pow(x, Rational { num, den })
