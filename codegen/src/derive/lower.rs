@@ -23,7 +23,7 @@ use crate::ir::{Constant, Function};
 
 /// How many times larger than an evaluated quantity as written its
 /// reduction may be and still be compiled to see which is cheaper.
-pub const REDUCED_GROWTH: usize = 10;
+const REDUCED_GROWTH: usize = 10;
 
 /// A function application replaced by a symbol while matrices are computed.
 struct Lowered {
@@ -239,12 +239,11 @@ impl Lowering {
 
     /// The forms an evaluated quantity is compiled from, the cheaper kept:
     /// `written`, then its reduction ([`Lowering::reduce_or_keep`]) where
-    /// that differs and is at most [`REDUCED_GROWTH`] times its size.
+    /// [`worth_compiling`].
     pub fn evaluated_forms(&self, written: Vec<Atom>) -> Result<Vec<Vec<Atom>>, Over> {
         let reduced =
             (written.iter().map(|a| self.reduce_or_keep(a))).collect::<Result<Vec<_>, _>>()?;
-        let size = |f: &[Atom]| f.iter().map(|a| size(a.as_view())).sum::<usize>();
-        let keep = reduced != written && size(&reduced) <= REDUCED_GROWTH * size(&written);
+        let keep = worth_compiling(&written, &reduced);
         Ok(std::iter::once(written)
             .chain(Some(reduced).filter(|_| keep))
             .collect())
@@ -340,6 +339,22 @@ impl<'l> Echelon<'l> {
     pub fn rank(&self) -> usize {
         self.rows.len()
     }
+}
+
+/// Whether `reduced`, the same quantity as `written` entry by entry, is
+/// worth compiling beside it: it differs, and is at most
+/// [`REDUCED_GROWTH`] times its size (compiling costs in proportion).
+pub fn worth_compiling<'a>(
+    written: impl IntoIterator<Item = &'a Atom>,
+    reduced: impl IntoIterator<Item = &'a Atom>,
+) -> bool {
+    let (mut differs, mut sizes) = (false, (0, 0));
+    for (w, r) in written.into_iter().zip(reduced) {
+        differs |= w != r;
+        sizes.0 += size(w.as_view());
+        sizes.1 += size(r.as_view());
+    }
+    differs && sizes.1 <= REDUCED_GROWTH * sizes.0
 }
 
 /// What a reduction past the budget names in its error: `what` (a

@@ -5,12 +5,11 @@
 
 use symbolica::prelude::*;
 
-use super::atoms::size;
 use super::budget::{self, Over};
 use super::build::Differentiate;
 use super::checks::{self, WallRows};
 use super::elimination;
-use super::lower::{self, Echelon, Lowering, REDUCED_GROWTH};
+use super::lower::{self, Echelon, Lowering};
 use super::mechanics::{Exact, Raw, RawWall};
 use super::output::{Form, Function, Geometry, Projection, WallDerivation};
 use super::symbols::Symbols;
@@ -564,7 +563,7 @@ fn projector(g_inv: &Matrix<Field>, b: &Matrix<Field>) -> Option<Matrix<Field>> 
 /// exactly where the `reduced` row's is (the elimination places the
 /// entries that are not zero, and a written entry that vanishes only by
 /// sin² + cos² = 1 would be placed), then reduced, by
-/// [`Lowering::evaluated_forms`]'s rule (the reduced alone where the
+/// [`lower::worth_compiling`] (the reduced alone where the
 /// zeros differ).
 fn row_forms(written: Vec<Vec<Atom>>, reduced: &[Vec<Atom>]) -> Vec<Vec<Vec<Atom>>> {
     let same_zeros = (written.iter().flatten())
@@ -573,8 +572,7 @@ fn row_forms(written: Vec<Vec<Atom>>, reduced: &[Vec<Atom>]) -> Vec<Vec<Vec<Atom
     if !same_zeros {
         return vec![reduced.to_vec()];
     }
-    let size = |f: &[Vec<Atom>]| f.iter().flatten().map(|a| size(a.as_view())).sum::<usize>();
-    let keep = reduced != written && size(reduced) <= REDUCED_GROWTH * size(&written);
+    let keep = lower::worth_compiling(written.iter().flatten(), reduced.iter().flatten());
     std::iter::once(written)
         .chain(Some(reduced.to_vec()).filter(|_| keep))
         .collect()
