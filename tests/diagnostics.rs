@@ -4,19 +4,31 @@
 //! symbolic engine: run one test at a time (`RUST_TEST_THREADS=1`).
 
 use std::path::Path;
+use std::time::{Duration, Instant};
 
 mod common;
 
+/// How long the derivation may take to refuse a bad model: a third of the
+/// 60 s every model file is held to, with room for a loaded machine. (The
+/// slowest here takes about a second; `rank_of_b_too_large` took 50 s
+/// before the elimination's steps were bounded.)
+const REFUSED_WITHIN: Duration = Duration::from_secs(20);
+
+/// Each is refused within [`REFUSED_WITHIN`] too: a model past a limit is
+/// stopped by the budget before the work it bounds, not after.
 #[test]
 fn every_bad_model_gets_its_diagnostics() {
     let files = common::toml_files(Path::new("tests/bad_models"));
     assert!(files.len() >= 20, "the corpus has {} files", files.len());
     for file in files {
         let name = file.file_stem().unwrap().to_string_lossy().into_owned();
+        let start = Instant::now();
         let errors = match dalembert_codegen::derive(&file) {
             Ok(_) => panic!("{} was accepted", file.display()),
             Err(e) => e,
         };
+        let took = start.elapsed();
+        assert!(took < REFUSED_WITHIN, "{name} was refused after {took:?}");
         assert!(!errors.errors.is_empty());
         // Plain form (what tools parse) and the rendered form (what people read).
         let text = format!("{errors}\n\n{}", errors.render());

@@ -323,6 +323,10 @@ impl<'l> Echelon<'l> {
                     continue;
                 }
                 let e = x.to_expression() - &factor * y.to_expression();
+                // Bounded before it is brought to lowest terms, as
+                // `to_rat` bounds its input: the combination's common
+                // denominator can be far larger than either row's.
+                budget::check(budget::rational_terms(&e))?;
                 *x = self.low.reduce_rat(self.low.rat(&e))?;
             }
         }
