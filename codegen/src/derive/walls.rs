@@ -266,17 +266,19 @@ fn rows(
         .map(|r| r.iter().map(|x| low.raise(&x.to_expression())).collect())
         .collect();
     let written: Vec<Vec<Atom>> = kept_at.iter().map(|&i| written[i].clone()).collect();
-    let forms = row_forms(written, &atoms);
     if sym.model.kind == Kind::Coordinates {
+        // Evaluated only, so as written: the same functions as the reduced
+        // rows, which can be far larger (a wall through nested atan).
         let rows = WallRows {
             surface: &raw.surface,
             normal: &raw.normal,
             holonomic: &c.raw.holonomic,
             a: &c.raw.a_rows,
-            b: &atoms,
+            b: &written,
         };
         checks::on_wall(sym, cx, w, &rows);
     }
+    let forms = row_forms(written, &atoms);
     Ok(Some(WallB {
         matrix,
         rats: b,
