@@ -8,21 +8,19 @@
 //! | [`linear_row`]: a velocity-level constraint is linear and homogeneous in v | pass 2, on each constraint and contact row |
 //! | [`no_velocity`]: V, h and f do not depend on v | pass 2 |
 //! | [`positive_definite`]: G > 0 at the sample point (on h = 0), with a hint where G fails only across h = 0 | after the mass matrix's program |
-//! | [`wall_hypotheses`]: (1.3) ker B ⊆ ker A and ker A ⊄ TN, exactly | per wall, for generic q |
+//! | [`wall_hypotheses`]: (1.3) ker B ⊆ ker A (by construction) and ker A ⊄ TN, exactly | per wall, for generic q, from B's exact elimination |
 //! | [`on_wall`]: B of full rank and (1.3) at a point of N (and h = 0) itself | per wall with a surface |
 
 use std::ops::Range;
 
 use symbolica::prelude::*;
 
-use super::budget::Over;
 use super::build::Differentiate;
 use super::evaluate::program;
-use super::lower::Lowering;
 use super::mechanics::Raw;
 use super::sample::onto;
 use super::symbols::Symbols;
-use super::{Rat, budget, is_zero};
+use super::{budget, is_zero};
 use crate::diag::{Collector, ErrorKind, Reported};
 use crate::ir::Wall;
 use crate::program::Program;
@@ -192,48 +190,31 @@ fn positive_on_constraints(
     Some(sym.model.holonomic[0].text.clone())
 }
 
-/// (1.3): ker B ⊆ ker A (A's rows lie in B's row space) and ker A ⊄ TN
-/// (the normal row is not in A's row space), checked exactly for generic
-/// parameters and configurations.
-pub fn wall_hypotheses(
-    cx: &mut Collector,
-    w: &Wall,
-    b: &[Vec<Rat>],
-    a: &[Vec<Rat>],
-    normal: &[Rat],
-    low: &Lowering,
-) -> Result<(), Over> {
-    let at = "generic parameters and configurations".to_string();
-    let rank = |rows: &[Vec<Rat>]| low.rank(rows);
-    let rb = rank(b)?;
-    let mut ba = b.to_vec();
-    ba.extend(a.iter().cloned());
-    if rank(&ba)? > rb {
-        cx.error(
-            ErrorKind::Hypothesis {
-                wall: w.name.clone(),
-                condition:
-                    "ker B ⊆ ker A (1.3): some constraint row is not implied by the wall's rows"
-                        .into(),
-                at: at.clone(),
-            },
-            Some(w.span.clone()),
-        );
-    }
-    let ra = rank(a)?;
-    let mut an = a.to_vec();
-    an.push(normal.to_vec());
-    if rank(&an)? == ra {
+/// (1.3) for generic parameters and configurations, from which of B's
+/// candidate rows (the normal velocity, then A's rows, then the contact
+/// rows) the exact elimination kept: `dropped` their places, `a_rows`
+/// how many rows A has.
+///
+/// - ker B ⊆ ker A (A's rows lie in B's row space) holds by construction:
+///   every row of A is a candidate, and a candidate is dropped only as a
+///   combination of the kept ones before it.
+/// - ker A ⊄ TN (the normal row is not in A's row space): A's rows are
+///   independent (the derivation stops otherwise), so the normal lies in
+///   their span, or is zero, exactly where one of the first 1 + `a_rows`
+///   candidates was dropped.
+///
+/// (Both were computed again by four more eliminations of the same rows.)
+pub fn wall_hypotheses(cx: &mut Collector, w: &Wall, dropped: &[usize], a_rows: usize) {
+    if dropped.iter().any(|&k| k <= a_rows) {
         cx.error(
             ErrorKind::Hypothesis {
                 wall: w.name.clone(),
                 condition: "ker A ⊄ TₓN (1.3): the constraints already forbid motion across the wall, or its normal velocity is zero".into(),
-                at,
+                at: "generic parameters and configurations".to_string(),
             },
             Some(w.span.clone()),
         );
     }
-    Ok(())
 }
 
 /// What [`on_wall`] evaluates: f, df, h and the rows of A and B.

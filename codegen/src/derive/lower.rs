@@ -179,6 +179,7 @@ impl Lowering {
 
     /// The rank of `rows` (entries from [`Lowering::to_rat`]) with the
     /// identities holding ([`Echelon`]).
+    #[cfg(test)]
     pub fn rank(&self, rows: &[Vec<Rat>]) -> Result<usize, Over> {
         let mut echelon = Echelon::new(self);
         for row in rows {
@@ -340,6 +341,7 @@ impl<'l> Echelon<'l> {
     }
 
     /// How many independent rows it holds.
+    #[cfg(test)]
     pub fn rank(&self) -> usize {
         self.rows.len()
     }

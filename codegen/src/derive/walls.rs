@@ -250,8 +250,7 @@ fn rows(
     )
     .map_err(|o| reduced(o, cx, w, "the rows of B"))?;
     let dropped: Vec<String> = dropped.into_iter().map(|(_, o)| o).collect();
-    checks::wall_hypotheses(cx, w, &b, &exact.a, &candidates[0].0, low)
-        .map_err(|o| reduced(o, cx, w, "the rows of B"))?;
+    checks::wall_hypotheses(cx, w, &dropped_at, exact.a.len());
     if kept.is_empty() {
         return Ok(None);
     }
