@@ -439,8 +439,9 @@ impl<'s, 'm, M: Surfaces<N>, const N: usize> Flight<'s, 'm, M, N> {
     /// `derivative`, (ẋ, δẋ) at (x, δx) ([`tangent`], or
     /// [`parameter_tangent`] along a direction of the parameters):
     /// through the step itself for a Runge–Kutta step, else along its
-    /// polynomial by `method` from a first step of `h` (updated to the
-    /// last one taken). See the module doc.
+    /// polynomial, by `method` from a first step of `h` (updated to the
+    /// length the control proposes next: the columns and steps that follow
+    /// need about the same). See the module doc.
     fn carry(
         &self,
         column: Phase<N>,
@@ -455,16 +456,21 @@ impl<'s, 'm, M: Surfaces<N>, const N: usize> Flight<'s, 'm, M, N> {
                 // The simulator's method, held to Φ's tolerance
                 // (Dormand–Prince; RK4 has no error estimate), tried first
                 // over the simulator's own step.
-                let rk = match rk {
-                    RungeKutta::DormandPrince(_) => RungeKutta::DormandPrince(method),
-                    rk4 => *rk4,
+                let (rk, first) = match rk {
+                    RungeKutta::DormandPrince(_) => (RungeKutta::DormandPrince(method), *h),
+                    // One step of the span: the step itself.
+                    rk4 => (*rk4, t1 - t0),
                 };
                 let start = Dual {
                     x: *dense.start(),
                     dx: column,
                 };
                 let mut rhs = |_: f64, y: &Dual<N>| derivative(model, y);
-                Ok(controlled(&rk, &mut rhs, start, t0, t1, t1 - t0)?.0.dx)
+                let (end, next) = controlled(&rk, &mut rhs, start, t0, t1, first)?;
+                if matches!(rk, RungeKutta::DormandPrince(_)) {
+                    *h = next;
+                }
+                Ok(end.dx)
             }
             _ => {
                 let mut rhs = |t: f64, d: &Phase<N>| {
@@ -514,7 +520,8 @@ fn parameter_tangent<M: Surfaces<N>, const N: usize>(
 
 /// y from t0 to t1 by `method` under its error control (one step of the
 /// span for a method without any), the first step at most `first`: the
-/// end, and the last step's length.
+/// end, and the step length the control proposes after it (from the last
+/// step not cut short to end at t1, where there was one).
 fn controlled<Y: Combine, W>(
     method: &RungeKutta,
     rhs: &mut impl FnMut(f64, &Y) -> Result<Y, VariationalError<W>>,
@@ -524,25 +531,31 @@ fn controlled<Y: Combine, W>(
     first: f64,
 ) -> Result<(Y, f64), VariationalError<W>> {
     let span = t1 - t0;
-    let (mut t, mut h, mut accepted) = (t0, first.min(span), span);
+    let (mut t, mut h, mut proposed) = (t0, first.min(span), None);
     let mut tries = 0;
     while t < t1 {
         let last = t + h >= t1 - 1e-12 * span;
         let h_now = if last { t1 - t } else { h };
         let f0 = rhs(t, &y)?;
         let (y1, error) = method.estimate(rhs, &y, &f0, t, h_now)?;
+        let next = h_now * method.factor(error);
         if error <= 1.0 && y1.finite() {
             y = y1;
             t = if last { t1 } else { t + h_now };
-            accepted = h_now;
             tries = 0;
+            if !last {
+                proposed = Some(next);
+            } else if proposed.is_none() {
+                // Cut short: what the control asked for before, if more.
+                proposed = Some(next.max(h));
+            }
         } else {
             tries += 1;
             if tries > 50 || !error.is_finite() {
                 return Err(VariationalError::Integration { t });
             }
         }
-        h = h_now * method.factor(error);
+        h = next;
     }
-    Ok((y, accepted))
+    Ok((y, proposed.unwrap_or(h)))
 }
