@@ -150,6 +150,9 @@ pub fn positive_definite(sym: &Symbols, raw: &Raw, cx: &mut Collector, mass_matr
         return;
     }
     let hint = match positive_on_constraints(sym, raw, &gm, &inputs) {
+        _ if !vals.iter().all(|x| x.is_finite()) => {
+            "; it has no value there (an entry is NaN or infinite: a function of the coordinates outside its domain, as asin of a number past 1)".to_string()
+        }
         Some(h) => format!(
             "; it is positive on the velocities the holonomic constraints allow but not across them, and the equations of motion need G > 0 everywhere: add to T a term that vanishes on them, such as (d/dt h)^2/2 for h = {h}"
         ),
@@ -258,6 +261,11 @@ pub fn on_wall(sym: &Symbols, cx: &mut Collector, w: &Wall, rows: &WallRows) {
         return;
     };
     let out = prog.eval(&x);
+    if !out.iter().all(|v| v.is_finite()) {
+        // A row without a value there (asin of an angle past 1, say): no
+        // rank to compare, and the generic checks stand.
+        return;
+    }
     let matrix = |from: usize, count: usize| -> nalgebra::DMatrix<f64> {
         nalgebra::DMatrix::from_fn(count, n, |i, j| out[from + i * n + j])
     };
@@ -270,15 +278,18 @@ pub fn on_wall(sym: &Symbols, cx: &mut Collector, w: &Wall, rows: &WallRows) {
         "the point {} of the wall",
         sym.point_description(&x[np..np + n])
     );
-    let rb = numeric_rank(&b_m);
+    let ranks = [&b_m, &stack(&b_m, &a_m), &stack(&a_m, &normal_m), &a_m].map(numeric_rank);
+    let [Some(rb), Some(rba), Some(ran), Some(ra)] = ranks else {
+        return;
+    };
     let mut failures = Vec::new();
     if rb < rows.b.len() {
         failures.push("B of full row rank");
     }
-    if numeric_rank(&stack(&b_m, &a_m)) > rb {
+    if rba > rb {
         failures.push("ker B ⊆ ker A (1.3)");
     }
-    if numeric_rank(&stack(&a_m, &normal_m)) == numeric_rank(&a_m) {
+    if ran == ra {
         failures.push("ker A ⊄ TₓN (1.3): the constraints forbid motion across the wall there");
     }
     for condition in failures {
@@ -302,11 +313,18 @@ fn stack(p: &nalgebra::DMatrix<f64>, q: &nalgebra::DMatrix<f64>) -> nalgebra::DM
 }
 
 /// Rank by singular values, relative to the largest.
-fn numeric_rank(m: &nalgebra::DMatrix<f64>) -> usize {
+/// The rank of `m` by its singular values, those above 1e-9 of the
+/// largest counted; `None` where the decomposition does not settle within
+/// a bounded number of sweeps (unbounded, a non-finite entry kept it
+/// going for ever).
+fn numeric_rank(m: &nalgebra::DMatrix<f64>) -> Option<usize> {
     if m.nrows() == 0 {
-        return 0;
+        return Some(0);
     }
-    let sv = m.clone().svd(false, false).singular_values;
+    let sv = m
+        .clone()
+        .try_svd(false, false, f64::EPSILON, 1000)?
+        .singular_values;
     let max = sv.iter().fold(0.0_f64, |a, b| a.max(*b));
-    sv.iter().filter(|s| **s > 1e-9 * max.max(1e-300)).count()
+    Some(sv.iter().filter(|s| **s > 1e-9 * max.max(1e-300)).count())
 }
