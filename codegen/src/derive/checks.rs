@@ -124,13 +124,13 @@ pub fn no_velocity(
     e: &Atom,
     span: &Range<usize>,
     kind: impl Fn(String) -> ErrorKind,
-) {
+) -> Result<(), Reported> {
     for (k, v) in sym.vels.iter().enumerate() {
         if !is_zero(&e.d(*v)) {
-            cx.error(kind(sym.model.velocities[k].clone()), Some(span.clone()));
-            return;
+            return Err(cx.error(kind(sym.model.velocities[k].clone()), Some(span.clone())));
         }
     }
+    Ok(())
 }
 
 /// G positive definite at the sample point (file's parameter values, the

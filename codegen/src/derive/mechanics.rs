@@ -96,10 +96,15 @@ pub fn raw(sym: &Symbols, cx: &mut Collector) -> Result<Raw, Reported> {
     let m = sym.model;
     let n = m.velocities.len();
     let t = sym.parse(&m.kinetic_energy, cx)?;
+    // A velocity in V, h or a wall's f: reported, the other checks of
+    // this pass go on, and the derivation stops at its end (the programs
+    // of those quantities read the coordinates alone).
+    let mut velocity = Ok(());
     let v = match &m.potential {
         Some(p) => {
             let v = sym.parse(p, cx)?;
-            checks::no_velocity(sym, cx, &v, &p.span, ErrorKind::VelocityInPotential);
+            let found = checks::no_velocity(sym, cx, &v, &p.span, ErrorKind::VelocityInPotential);
+            velocity = velocity.and(found);
             v
         }
         None => Atom::num(0),
@@ -124,7 +129,8 @@ pub fn raw(sym: &Symbols, cx: &mut Collector) -> Result<Raw, Reported> {
     let mut holonomic = Vec::new();
     for (k, c) in m.holonomic.iter().enumerate() {
         let h = sym.parse(c, cx)?;
-        checks::no_velocity(sym, cx, &h, &c.span, ErrorKind::VelocityInHolonomic);
+        let found = checks::no_velocity(sym, cx, &h, &c.span, ErrorKind::VelocityInHolonomic);
+        velocity = velocity.and(found);
         let what = format!("holonomic constraint {}", k + 1);
         let mut row = Vec::with_capacity(n);
         let mut bound = budget::Running::default();
@@ -156,11 +162,11 @@ pub fn raw(sym: &Symbols, cx: &mut Collector) -> Result<Raw, Reported> {
         .zip(a_spans.iter().zip(&a_labels))
         .map(|(row, (span, what))| drift(sym, cx, row, span, what))
         .collect::<Result<Vec<_>, _>>()?;
-    let walls = m
-        .walls
-        .iter()
-        .map(|w| raw_wall(sym, cx, w))
-        .collect::<Result<Vec<_>, _>>()?;
+    // Every wall's checks, then the first failure.
+    let walls: Vec<Result<RawWall, Reported>> =
+        m.walls.iter().map(|w| raw_wall(sym, cx, w)).collect();
+    let walls = walls.into_iter().collect::<Result<Vec<_>, _>>()?;
+    velocity?;
     Ok(Raw {
         t,
         v,
@@ -190,7 +196,7 @@ fn raw_wall(sym: &Symbols, cx: &mut Collector, w: &Wall) -> Result<RawWall, Repo
             checks::no_velocity(sym, cx, &f, &e.span, |v| ErrorKind::VelocityInSurface {
                 wall: w.name.clone(),
                 velocity: v,
-            });
+            })?;
             let what = format!("wall `{}`'s surface", w.name);
             let mut row = vec![Atom::num(0); n];
             for (k, q) in sym.coords.iter().enumerate() {
