@@ -312,7 +312,6 @@ fn stack(p: &nalgebra::DMatrix<f64>, q: &nalgebra::DMatrix<f64>) -> nalgebra::DM
     m
 }
 
-/// Rank by singular values, relative to the largest.
 /// The rank of `m` by its singular values, those above 1e-9 of the
 /// largest counted; `None` where the decomposition does not settle within
 /// a bounded number of sweeps (unbounded, a non-finite entry kept it

@@ -140,7 +140,7 @@ impl Lowering {
         a
     }
 
-    fn rat(&self, a: &Atom) -> Rat {
+    pub(super) fn rat(&self, a: &Atom) -> Rat {
         a.to_rational_polynomial(&Q, &Z, Some(self.vars.clone()))
     }
 
@@ -164,7 +164,7 @@ impl Lowering {
     /// A rational function of the lowered symbols with its numerator and
     /// denominator reduced by the identities, as [`Lowering::to_rat`]
     /// gives one.
-    fn reduce_rat(&self, r: Rat) -> Result<Rat, Over> {
+    pub(super) fn reduce_rat(&self, r: Rat) -> Result<Rat, Over> {
         if self.pairs.is_empty() {
             return Ok(r);
         }
@@ -175,17 +175,6 @@ impl Lowering {
             return Ok(r);
         }
         Ok(self.rat(&(num / den)))
-    }
-
-    /// The rank of `rows` (entries from [`Lowering::to_rat`]) with the
-    /// identities holding ([`Echelon`]).
-    #[cfg(test)]
-    pub fn rank(&self, rows: &[Vec<Rat>]) -> Result<usize, Over> {
-        let mut echelon = Echelon::new(self);
-        for row in rows {
-            echelon.insert(row)?;
-        }
-        Ok(echelon.rank())
     }
 
     /// Reduces a polynomial modulo c² + s² − 1 for every sin/cos pair and
@@ -283,67 +272,6 @@ impl Lowering {
         } else {
             terms.join(" + ")
         })
-    }
-}
-
-/// Rows brought to echelon form one at a time, over the rational
-/// functions of a [`Lowering`]'s symbols with sin² + cos² = 1 and
-/// cosh² − sinh² = 1 holding: every entry an elimination step makes is
-/// reduced by the identities, whose reduced numerators are a normal form
-/// (degree at most 1 in each cos and cosh), so a combination of rows that
-/// vanishes only by the identities is found to vanish. (An exact rank over
-/// the field that treats sin and cos as independent symbols misses such
-/// combinations: a rolling disk's rows and its rough wall's contact rows
-/// are dependent only through them.)
-pub struct Echelon<'l> {
-    low: &'l Lowering,
-    /// The rows so far, each with the column of its pivot; every row is
-    /// zero in the pivot columns of the rows before it.
-    rows: Vec<(usize, Vec<Rat>)>,
-}
-
-impl<'l> Echelon<'l> {
-    pub fn new(low: &'l Lowering) -> Self {
-        Self {
-            low,
-            rows: Vec::new(),
-        }
-    }
-
-    /// Adds `row` (entries from [`Lowering::to_rat`]) if it is independent
-    /// of the rows so far; whether it was.
-    pub fn insert(&mut self, row: &[Rat]) -> Result<bool, Over> {
-        let mut row = row.to_vec();
-        for (p, pivot) in &self.rows {
-            if row[*p].numerator.is_zero() {
-                continue;
-            }
-            let factor = row[*p].to_expression() / pivot[*p].to_expression();
-            for (x, y) in row.iter_mut().zip(pivot) {
-                if y.numerator.is_zero() {
-                    continue;
-                }
-                let e = x.to_expression() - &factor * y.to_expression();
-                // Bounded before it is brought to lowest terms, as
-                // `to_rat` bounds its input: the combination's common
-                // denominator can be far larger than either row's.
-                budget::check(budget::rational_terms(&e))?;
-                *x = self.low.reduce_rat(self.low.rat(&e))?;
-            }
-        }
-        Ok(match row.iter().position(|x| !x.numerator.is_zero()) {
-            Some(p) => {
-                self.rows.push((p, row));
-                true
-            }
-            None => false,
-        })
-    }
-
-    /// How many independent rows it holds.
-    #[cfg(test)]
-    pub fn rank(&self) -> usize {
-        self.rows.len()
     }
 }
 
@@ -534,6 +462,7 @@ fn sum(mut terms: Vec<Atom>) -> Atom {
 
 #[cfg(test)]
 mod tests {
+    use super::super::echelon::Echelon;
     use super::super::inspect::same;
     use super::*;
     use crate::derive::build::Namespace;
@@ -566,8 +495,6 @@ mod tests {
         assert!(terms.iter().all(|&k| k == 1), "{reduced}");
     }
 
-    /// Zero only by sin² + cos² = 1 or cosh² − sinh² = 1, powers
-    /// included; and near misses that are not zero.
     /// (cos x, sin x) and cos x times it, whose first entry reduces to
     /// 1 − sin² x: dependent only through sin² + cos² = 1 once elimination
     /// has combined them (the plain rank over the rational functions of
@@ -588,7 +515,9 @@ mod tests {
                 .collect();
             let field = super::super::Field::from_poly(&rats[0][0].numerator);
             let plain = super::super::rows_matrix(&rats, 2, &field).unwrap().rank();
-            (low.rank(&rats).unwrap(), plain)
+            let mut echelon = Echelon::new(&low);
+            let kept = (rats.iter()).filter(|r| echelon.insert(r).unwrap()).count();
+            (kept, plain)
         };
         let dependent = vec![vec![c.clone(), s.clone()], vec![&c * &c, &s * &c]];
         assert_eq!(rank(dependent), (1, 2));
@@ -596,6 +525,8 @@ mod tests {
         assert_eq!(rank(independent).0, 2);
     }
 
+    /// Zero only by sin² + cos² = 1 or cosh² − sinh² = 1, powers
+    /// included; and near misses that are not zero.
     #[test]
     fn squares_of_pairs_reduce() {
         for (a, b) in [

@@ -9,7 +9,8 @@ use std::ops::Range;
 use symbolica::prelude::*;
 
 use super::build::Differentiate;
-use super::lower::{self, Echelon, Lowering};
+use super::echelon::Echelon;
+use super::lower::{self, Lowering};
 use super::symbols::Symbols;
 use super::{Field, Rat, is_zero, rows_matrix};
 use super::{budget, checks};

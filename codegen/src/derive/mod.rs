@@ -24,6 +24,7 @@ mod budget;
 mod build;
 mod checks;
 mod coefficients;
+mod echelon;
 mod elimination;
 mod evaluate;
 pub mod inspect;

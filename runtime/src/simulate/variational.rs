@@ -5,13 +5,16 @@
 //! carries Φ over it; at a collision it applies the saltation matrix
 //! ([`saltation`]), Φ⁺ = S Φ⁻. Between collisions:
 //!
-//! - after a Runge–Kutta step (RK4, Dormand–Prince), Φ is carried through
-//!   *the step itself*: the method's stages are run again on pairs
-//!   (x, δx), each stage's δ one tangent of q̈
-//!   ([`Dynamics::accelerations_tangent`]), from the step's start over its
-//!   length (up to the collision instant for a step that ends at one). So
-//!   each column of Φ is the derivative of the computed solution, with
-//!   no tolerance of its own, at 2N tangents a stage;
+//! - after a Runge–Kutta step, Φ is carried by the same method over the
+//!   same span (up to the collision instant for a step that ends at one),
+//!   from the step's start, on pairs (x, δx), each stage's δ one tangent
+//!   of q̈ ([`Dynamics::accelerations_tangent`]): 2N tangents a stage. For
+//!   RK4 that is *the step itself* (one step of the span), so each column
+//!   is the derivative of the computed solution. Dormand–Prince holds each
+//!   column to Φ's own tolerance instead, in as many steps as that takes
+//!   (the motion's steps can be far longer than its perturbations allow:
+//!   a flight that is a parabola), each column's first step the length
+//!   the control proposed last;
 //! - after a step of Taylor's method, each column of Φ is carried by a
 //!   polynomial: the model's series of the variational equation
 //!   Φ̇ = J(x(t)) Φ, J = [[0, I], [∂q̈/∂q, ∂q̈/∂q̇]], along the step's
@@ -113,9 +116,9 @@ pub enum VariationalError<W> {
 
 impl<const N: usize> Variational<N> {
     /// Φ = I. `rtol` is the relative tolerance (absolute `rtol`·1e-2 on
-    /// entries that start at one) of Φ's own integration along steps of
-    /// Taylor's method; a Runge–Kutta step is differentiated itself and
-    /// needs none (module doc).
+    /// entries that start at one) of Φ's own integration over steps of
+    /// Dormand–Prince and along steps of Taylor's method; an RK4 step is
+    /// differentiated itself and needs none (module doc).
     pub fn new(rtol: f64) -> Self {
         Self {
             phi: StateMatrix::identity(),
