@@ -18,14 +18,16 @@ use dalembert_runtime::taylor::Work;
 
 use super::machine::{Machine, lower};
 use super::{Instr, Program, Slot, constant};
-use crate::function::{Function, Recurrences};
+use crate::function::Recurrences;
 
 mod evaluate;
 mod functions;
 mod negations;
+mod op;
 mod quotients;
 mod solve;
 pub use evaluate::Evaluation;
+pub use op::{Op, Summand};
 pub use solve::Solve;
 
 /// A series the transform reads or writes.
@@ -50,56 +52,6 @@ pub enum Term {
     /// A series negated: only as an output, where `negations.rs` moved
     /// the sign of a negation.
     Negated(Series),
-}
-
-/// A term of a sum: a series added, or subtracted.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Summand {
-    pub series: Series,
-    pub minus: bool,
-}
-
-/// One coefficient of one intermediate series from coefficients of others
-/// (`dst` is always a [`Series::Temp`]).
-#[derive(Debug, Clone, PartialEq)]
-pub enum Op {
-    /// Σ ±series, in order, + Σ numbers (the numbers count at order 0
-    /// only).
-    Add {
-        dst: Series,
-        series: Vec<Summand>,
-        numbers: Vec<Slot>,
-    },
-    /// a times a number.
-    Scale { dst: Series, a: Series, by: Slot },
-    /// a·b.
-    Mul { dst: Series, a: Series, b: Series },
-    /// a².
-    Square { dst: Series, a: Series },
-    /// 1/a.
-    Recip { dst: Series, a: Series },
-    /// a/b (a product with a reciprocal, fused: see `quotients.rs`).
-    Div { dst: Series, a: Series, b: Series },
-    /// √a.
-    Sqrt { dst: Series, a: Series },
-    /// a^α for a real α.
-    Power { dst: Series, a: Series, alpha: f64 },
-    /// exp(a).
-    Exp { dst: Series, a: Series },
-    /// ln(a).
-    Log { dst: Series, a: Series },
-    /// sin(a) and cos(a) together.
-    SinCos { sin: Series, cos: Series, a: Series },
-    /// c = f(a) for an arc function, from c′·w = a′ (−a′ when `minus`)
-    /// and c₀ = f(a₀): atan with w = 1 + a², asin with w = √(1 − a²),
-    /// acos with the same w and `minus`.
-    Arc {
-        dst: Series,
-        a: Series,
-        w: Series,
-        f: Function,
-        minus: bool,
-    },
 }
 
 /// A program's Taylor transform.
@@ -374,35 +326,6 @@ fn with_sources(ins: &Instr, dst: Slot, sources: &[Slot]) -> Instr {
     }
 }
 
-impl Op {
-    /// What it writes (both halves for a sin/cos pair).
-    pub fn writes(&self) -> Vec<Series> {
-        match self {
-            Op::SinCos { sin, cos, .. } => vec![*sin, *cos],
-            _ => self.dst().into_iter().collect(),
-        }
-    }
-
-    /// The one series this op writes; `None` for a sin/cos pair, which
-    /// writes two. (No allocation: the interpreter asks at every order.)
-    pub fn dst(&self) -> Option<Series> {
-        match self {
-            Op::SinCos { .. } => None,
-            Op::Add { dst, .. }
-            | Op::Scale { dst, .. }
-            | Op::Mul { dst, .. }
-            | Op::Div { dst, .. }
-            | Op::Square { dst, .. }
-            | Op::Recip { dst, .. }
-            | Op::Sqrt { dst, .. }
-            | Op::Power { dst, .. }
-            | Op::Exp { dst, .. }
-            | Op::Log { dst, .. }
-            | Op::Arc { dst, .. } => Some(*dst),
-        }
-    }
-}
-
 impl Transform {
     /// The same transform with the ops that read no series of coordinate
     /// or velocity `n` or beyond (directly or through other ops) moved
@@ -511,6 +434,7 @@ impl Transform {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::function::Function;
     use dalembert_runtime::__private::taylor as tay;
 
     /// q̈ = −(g/l)·sin q (the pendulum): the transform's series of q is

@@ -39,47 +39,6 @@ pub(super) fn fuse(ops: Vec<Op>, outputs: &[Term]) -> Vec<Op> {
         .collect()
 }
 
-impl Op {
-    /// The series it reads (its own lower coefficients not counted).
-    pub(super) fn reads(&self) -> Vec<Series> {
-        match self {
-            Op::Add { series, .. } => series.iter().map(|t| t.series).collect(),
-            Op::Mul { a, b, .. } | Op::Div { a, b, .. } => vec![*a, *b],
-            Op::Arc { a, w, .. } => vec![*a, *w],
-            Op::Scale { a, .. }
-            | Op::Square { a, .. }
-            | Op::Recip { a, .. }
-            | Op::Sqrt { a, .. }
-            | Op::Power { a, .. }
-            | Op::Exp { a, .. }
-            | Op::Log { a, .. }
-            | Op::SinCos { a, .. } => vec![*a],
-        }
-    }
-
-    /// Replaces each series it reads or writes by the one `rename` gives.
-    pub(super) fn rename(&mut self, r: &impl Fn(Series) -> Series) {
-        match self {
-            Op::Add { dst, series, .. } => {
-                *dst = r(*dst);
-                series.iter_mut().for_each(|t| t.series = r(t.series));
-            }
-            Op::Mul { dst, a, b } | Op::Div { dst, a, b } => {
-                (*dst, *a, *b) = (r(*dst), r(*a), r(*b));
-            }
-            Op::Scale { dst, a, .. }
-            | Op::Square { dst, a }
-            | Op::Recip { dst, a }
-            | Op::Sqrt { dst, a }
-            | Op::Power { dst, a, .. }
-            | Op::Exp { dst, a }
-            | Op::Log { dst, a } => (*dst, *a) = (r(*dst), r(*a)),
-            Op::SinCos { sin, cos, a } => (*sin, *cos, *a) = (r(*sin), r(*cos), r(*a)),
-            Op::Arc { dst, a, w, .. } => (*dst, *a, *w) = (r(*dst), r(*a), r(*w)),
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::super::Evaluation;
