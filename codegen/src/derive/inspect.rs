@@ -51,8 +51,8 @@ pub fn same_with(a: &str, b: &str, definitions: &[(String, String)]) -> Result<b
             "the difference, reduced by sin² + cos² = 1, may expand to {bound:.0} terms; the limit is {:.0}",
             budget::MAX_EXPANDED_TERMS
         ),
-        // (A zero test divides by nothing.)
-        budget::Over::VanishingDenominator => "the difference has no value".to_string(),
+        // (A zero test multiplies no matrices and divides by nothing.)
+        budget::Over::Product(_) | budget::Over::VanishingDenominator => "the difference has no value".to_string(),
     })
 }
 

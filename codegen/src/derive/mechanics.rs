@@ -8,12 +8,13 @@ use std::ops::Range;
 
 use symbolica::prelude::*;
 
+use super::budget::Over;
 use super::build::Differentiate;
 use super::echelon::Echelon;
 use super::lower::{self, Lowering};
 use super::symbols::Symbols;
 use super::{Field, Rat, is_zero, rows_matrix};
-use super::{budget, checks};
+use super::{bounded, budget, checks};
 use crate::diag::{Collector, ErrorKind, Reported};
 use crate::ir::{Kind, ProjectorMode, Wall};
 
@@ -512,7 +513,8 @@ pub fn accelerations(
         let c = column(&raw.drift).ok_or_else(|| fail("Ȧq̇ as a column"))?;
         Some((a, c))
     };
-    let Some(x) = solve_motion(g_inv, constrained.as_ref(), &neg_h) else {
+    // Past the budget of its steps, q̈ is solved at run time instead.
+    let Ok(Some(x)) = solve_motion(g_inv, constrained.as_ref(), &neg_h) else {
         return Ok(None);
     };
     let q_ddot = (0..n).map(|i| low.simplify(&x[(i as u32, 0)]));
@@ -524,17 +526,21 @@ pub fn accelerations(
 
 /// q̈ of G q̈ + h = Aᵀλ, A q̈ + Ȧq̇ = 0, from −h and (A, −Ȧq̇): with
 /// z = −G⁻¹h and Y = G⁻¹Aᵀ, (AY)λ = −Ȧq̇ − Az and q̈ = z + Yλ. `None` when
-/// AY is singular (dependent rows of A).
+/// AY is singular (dependent rows of A), [`Over`] where a product or
+/// inverse is past the budget ([`bounded`]).
 fn solve_motion(
     g_inv: &Matrix<Field>,
     constraints: Option<&(Matrix<Field>, Matrix<Field>)>,
     neg_h: &Matrix<Field>,
-) -> Option<Matrix<Field>> {
-    let z = g_inv * neg_h;
+) -> Result<Option<Matrix<Field>>, Over> {
+    let z = bounded::mul(g_inv, neg_h)?;
     let Some((a, neg_c)) = constraints else {
-        return Some(z);
+        return Ok(Some(z));
     };
-    let y = g_inv * &a.transpose();
-    let lambda = &(a * &y).inv().ok()? * &(neg_c - &(a * &z));
-    Some(&z + &(&y * &lambda))
+    let y = bounded::mul(g_inv, &a.transpose())?;
+    let Some(ay_inv) = bounded::inv(&bounded::mul(a, &y)?)? else {
+        return Ok(None);
+    };
+    let lambda = bounded::mul(&ay_inv, &(neg_c - &bounded::mul(a, &z)?))?;
+    Ok(Some(&z + &bounded::mul(&y, &lambda)?))
 }

@@ -20,6 +20,7 @@
 //! helpers for front ends and tests.
 
 mod atoms;
+mod bounded;
 mod budget;
 mod build;
 mod checks;

@@ -5,6 +5,7 @@
 
 use symbolica::prelude::*;
 
+use super::bounded;
 use super::budget::{self, Over};
 use super::build::Differentiate;
 use super::checks::{self, WallRows};
@@ -82,19 +83,21 @@ fn wall(
             span.clone(),
         ));
     }
-    let closed = match g_inv {
-        Some(g_inv) => Some(
-            (closed_form(sym, low, g_inv, &b_mat))
-                .map_err(|o| reduced(o, cx, w, "the projector P"))?
-                .ok_or_else(|| {
-                    cx.error(
+    // Chosen (`auto`), a closed form whose steps are past the budget gives
+    // way to P solved at run time too, where the kept rows allow it.
+    let closed = match g_inv.map(|g_inv| closed_form(sym, low, g_inv, &b_mat)) {
+        Some(Ok(Some(closed))) => Some(closed),
+        Some(Ok(None)) => {
+            return Err(cx.error(
                 ErrorKind::Structure(format!(
                     "wall `{}`: BG⁻¹Bᵀ is singular for generic parameters and configurations, so P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B does not exist",
                     w.name
                 )),
                 span.clone(),
-            )
-        })?),
+            ));
+        }
+        Some(Err(_)) if sym.model.projector == ProjectorMode::Auto && steady => None,
+        Some(Err(o)) => return Err(reduced(o, cx, w, "the projector P")),
         None => None,
     };
     let normal =
@@ -291,7 +294,8 @@ fn rows(
 }
 
 /// P entry by entry and (I − 2P)v, simplified; `None` when BG⁻¹Bᵀ is
-/// singular, [`Over`] where the simplification is past the budget.
+/// singular, [`Over`] where a step of P or its simplification is past
+/// the budget.
 #[allow(clippy::type_complexity, clippy::needless_range_loop)]
 fn closed_form(
     sym: &Symbols,
@@ -300,7 +304,7 @@ fn closed_form(
     b: &Matrix<Field>,
 ) -> Result<Option<(Vec<Vec<Atom>>, Vec<Atom>)>, Over> {
     let n = sym.vels.len();
-    let Some(p) = projector(g_inv, b) else {
+    let Some(p) = projector(g_inv, b)? else {
         return Ok(None);
     };
     let p_atoms = simplified(low, &p, n, n)?;
@@ -431,14 +435,15 @@ fn row_cost(row: &[Atom]) -> usize {
 /// What the admissible collision map's reductions name in their errors.
 const ON_KER_A: &str = "the collision map on admissible velocities";
 
-/// The error of a reduction past the budget in `what`, at the wall's `span`.
-/// `o` reported at wall `w`, naming `what` of it.
+/// The error of `o`, a step past the budget in `what` of wall `w`, at the
+/// wall.
 fn reduced(o: Over, cx: &mut Collector, w: &Wall, what: &str) -> Reported {
-    o.report(
-        cx,
-        &w.span,
-        &lower::reduced(&format!("{what} of wall `{}`", w.name)),
-    )
+    let what = format!("{what} of wall `{}`", w.name);
+    let what = match o {
+        Over::Product(_) => what,
+        _ => lower::reduced(&what),
+    };
+    o.report(cx, &w.span, &what)
 }
 
 /// The entries of a rows × cols matrix, simplified.
@@ -553,12 +558,14 @@ fn linear_map(
     }))
 }
 
-/// P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B.
-fn projector(g_inv: &Matrix<Field>, b: &Matrix<Field>) -> Option<Matrix<Field>> {
-    let x = g_inv * &b.transpose();
-    let m = b * &x;
-    let m_inv = m.inv().ok()?;
-    Some(&(&x * &m_inv) * b)
+/// P = G⁻¹Bᵀ(BG⁻¹Bᵀ)⁻¹B, each step within the budget ([`bounded`]);
+/// `None` where BG⁻¹Bᵀ is singular.
+fn projector(g_inv: &Matrix<Field>, b: &Matrix<Field>) -> Result<Option<Matrix<Field>>, Over> {
+    let x = bounded::mul(g_inv, &b.transpose())?;
+    let Some(m_inv) = bounded::inv(&bounded::mul(b, &x)?)? else {
+        return Ok(None);
+    };
+    Ok(Some(bounded::mul(&bounded::mul(&x, &m_inv)?, b)?))
 }
 
 /// B's kept rows to evaluate: as `written` where each entry is zero
