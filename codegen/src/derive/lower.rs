@@ -229,10 +229,37 @@ impl Lowering {
 
     /// The forms an evaluated quantity is compiled from, the cheaper kept:
     /// `written`, then its reduction ([`Lowering::reduce_or_keep`]) where
-    /// [`worth_compiling`].
+    /// [`worth_compiling`]. The reduction is finished only where its terms
+    /// in lowest terms, a lower bound on its size, leave it within
+    /// [`REDUCED_GROWTH`] of the written form's (its second pass through
+    /// the identities and raising the functions again cost the most; an
+    /// exponential's terms can merge when expanded, so with one it is
+    /// always finished).
     pub fn evaluated_forms(&self, written: Vec<Atom>) -> Result<Vec<Vec<Atom>>, Over> {
-        let reduced =
-            (written.iter().map(|a| self.reduce_or_keep(a))).collect::<Result<Vec<_>, _>>()?;
+        let rats = (written.iter())
+            .map(|a| match self.to_rat(a) {
+                Ok(r) => Ok(Some(r)),
+                Err(Over::Terms(_)) => Ok(None),
+                Err(o) => Err(o),
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let least: usize = (written.iter().zip(&rats))
+            .map(|(w, r)| match r {
+                Some(r) if r.denominator.is_constant() => r.numerator.nterms(),
+                Some(r) => r.numerator.nterms() + r.denominator.nterms(),
+                None => size(w.as_view()),
+            })
+            .sum();
+        let sizes: usize = written.iter().map(|w| size(w.as_view())).sum();
+        if least > REDUCED_GROWTH * sizes && !written.iter().any(|w| holds_exp(w.as_view())) {
+            return Ok(vec![written]);
+        }
+        let reduced = (written.iter().zip(rats))
+            .map(|(w, r)| match r.map(|r| self.simplify(&r)) {
+                Some(Err(Over::Terms(_))) | None => Ok(w.clone()),
+                Some(reduced) => reduced,
+            })
+            .collect::<Result<Vec<_>, _>>()?;
         let keep = worth_compiling(&written, &reduced);
         Ok(std::iter::once(written)
             .chain(Some(reduced).filter(|_| keep))
