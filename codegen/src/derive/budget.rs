@@ -87,6 +87,26 @@ impl Over {
 /// 2026-12-08).
 pub const MAX_PRODUCT_TERMS: f64 = 1_000_000.0;
 
+/// Most terms (numerator and denominator, in lowest terms) an entry of q̈
+/// in closed form may have; past it q̈ is solved at run time, in a few
+/// hundred operations, instead of simplified, compiled and evaluated in
+/// thousands. The largest in the models shipped are 3194 (`chain_4_symbolic`)
+/// and 3165 (the Chaplygin ball as a quaternion, q̈ in 4284 operations);
+/// the Chaplygin ball's quaternion with its centre at x·acosh(x + i₂) has
+/// 44 087 and ran past 100 s simplifying them, a rolling shell's at
+/// x·acosh(x + φ) 35 635, 15 032 operations (`dalembert generate`,
+/// 2026-12-08).
+pub const MAX_CLOSED_FORM_TERMS: f64 = 10_000.0;
+
+/// The most nodes an entry of q̈ in closed form may have as the
+/// expression compiled (exponentials expanded); past it q̈ is solved at
+/// run time. The largest in the models shipped is 52 482 (the Chaplygin
+/// ball as a quaternion, which derives in 3 s); with its centre at
+/// x·exp(x + i₂), an entry of 2 072 terms had 8.9 million once its
+/// exponentials were expanded, and compiling it took 30 s (4 609
+/// operations; solved at run time, 30 s → 0.4 s, 717).
+pub const MAX_CLOSED_FORM_SIZE: usize = 100_000;
+
 /// [`Over`] when `bound` terms exceed [`MAX_EXPANDED_TERMS`].
 pub fn check(bound: f64) -> Result<(), Over> {
     if bound > MAX_EXPANDED_TERMS {

@@ -8,6 +8,7 @@ use std::ops::Range;
 
 use symbolica::prelude::*;
 
+use super::atoms::size;
 use super::budget::Over;
 use super::build::Differentiate;
 use super::echelon::Echelon;
@@ -513,15 +514,24 @@ pub fn accelerations(
         let c = column(&raw.drift).ok_or_else(|| fail("Ȧq̇ as a column"))?;
         Some((a, c))
     };
-    // Past the budget of its steps, q̈ is solved at run time instead.
+    // Past the budget of its steps or of its terms or size, q̈ is solved
+    // at run time instead.
     let Ok(Some(x)) = solve_motion(g_inv, constrained.as_ref(), &neg_h) else {
         return Ok(None);
     };
+    let terms = |r: &Rat| (r.numerator.nterms() + r.denominator.nterms()) as f64;
+    if (0..n).any(|i| terms(&x[(i as u32, 0)]) > budget::MAX_CLOSED_FORM_TERMS) {
+        return Ok(None);
+    }
     let q_ddot = (0..n).map(|i| low.simplify(&x[(i as u32, 0)]));
-    q_ddot.collect::<Result<_, _>>().map(Some).map_err(|o| {
+    let q_ddot = q_ddot.collect::<Result<Vec<_>, _>>().map_err(|o| {
         let what = lower::reduced("the accelerations q̈");
         o.report(cx, &sym.model.kinetic_energy.span, &what)
-    })
+    })?;
+    // Written out with its exponentials expanded, a closed form within
+    // the terms can still be huge to compile.
+    let largest = (q_ddot.iter().map(|a| size(a.as_view()))).max();
+    Ok((largest <= Some(budget::MAX_CLOSED_FORM_SIZE)).then_some(q_ddot))
 }
 
 /// q̈ of G q̈ + h = Aᵀλ, A q̈ + Ȧq̇ = 0, from −h and (A, −Ȧq̇): with
