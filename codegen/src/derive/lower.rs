@@ -229,12 +229,13 @@ impl Lowering {
 
     /// The forms an evaluated quantity is compiled from, the cheaper kept:
     /// `written`, then its reduction ([`Lowering::reduce_or_keep`]) where
-    /// [`worth_compiling`]. The reduction is finished only where its terms
-    /// in lowest terms, a lower bound on its size, leave it within
-    /// [`REDUCED_GROWTH`] of the written form's (its second pass through
-    /// the identities and raising the functions again cost the most; an
-    /// exponential's terms can merge when expanded, so with one it is
-    /// always finished).
+    /// [`worth_compiling`]. Without sin/cos or sinh/cosh pairs the
+    /// reduction is finished only where its terms in lowest terms, a lower
+    /// bound on its size, leave it within [`REDUCED_GROWTH`] of the written
+    /// form's (raising the functions again and writing it out cost the
+    /// most). With pairs it is always finished, since it may find a
+    /// denominator vanishing by the identities, an error; with an
+    /// exponential too, whose terms can merge when expanded.
     pub fn evaluated_forms(&self, written: Vec<Atom>) -> Result<Vec<Vec<Atom>>, Over> {
         let rats = (written.iter())
             .map(|a| match self.to_rat(a) {
@@ -251,7 +252,8 @@ impl Lowering {
             })
             .sum();
         let sizes: usize = written.iter().map(|w| size(w.as_view())).sum();
-        if least > REDUCED_GROWTH * sizes && !written.iter().any(|w| holds_exp(w.as_view())) {
+        let finished = !self.pairs.is_empty() || written.iter().any(|w| holds_exp(w.as_view()));
+        if least > REDUCED_GROWTH * sizes && !finished {
             return Ok(vec![written]);
         }
         let reduced = (written.iter().zip(rats))
