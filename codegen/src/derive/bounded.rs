@@ -40,11 +40,7 @@ pub fn inv(a: &Matrix<Field>) -> Result<Option<Matrix<Field>>, Over> {
     let counts: Vec<Vec<Option<u64>>> = (0..a.nrows() as u32)
         .map(|i| {
             (0..a.ncols() as u32)
-                .map(|j| {
-                    let x = &a[(i, j)];
-                    (!x.numerator.is_constant() || x.numerator.is_zero())
-                        .then(|| x.numerator.nterms() as u64)
-                })
+                .map(|j| budget::numerator_count(&a[(i, j)]))
                 .collect()
         })
         .collect();

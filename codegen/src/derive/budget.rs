@@ -104,7 +104,7 @@ pub const MAX_CLOSED_FORM_TERMS: f64 = 10_000.0;
 /// ball as a quaternion, which derives in 3 s); with its centre at
 /// x·exp(x + i₂), an entry of 2 072 terms had 8.9 million once its
 /// exponentials were expanded, and compiling it took 30 s (4 609
-/// operations; solved at run time, 30 s → 0.4 s, 717).
+/// operations; solved at run time, 30 s → 0.8 s, 709).
 pub const MAX_CLOSED_FORM_SIZE: usize = 100_000;
 
 /// [`Over`] when `bound` terms exceed [`MAX_EXPANDED_TERMS`].
@@ -331,18 +331,24 @@ pub fn bordered_terms(g: &[Vec<Atom>], b: &[Vec<Rat>]) -> f64 {
     }
     for (r, row) in b.iter().enumerate() {
         for (j, x) in row.iter().enumerate() {
-            let c = if x.numerator.is_zero() {
-                Some(0)
-            } else if x.numerator.is_constant() {
-                None
-            } else {
-                Some(x.numerator.nterms() as u64)
-            };
+            let c = numerator_count(x);
             counts[n + r][j] = c;
             counts[j][n + r] = c;
         }
     }
     estimate(&counts)
+}
+
+/// An exact entry's count for [`estimate`]: its numerator's terms (0 for
+/// zero), `None` for a plain number.
+pub fn numerator_count(x: &Rat) -> Option<u64> {
+    if x.numerator.is_zero() {
+        Some(0)
+    } else if x.numerator.is_constant() {
+        None
+    } else {
+        Some(x.numerator.nterms() as u64)
+    }
 }
 
 /// The largest block's bound, from the entries' term counts (`None` for a
